@@ -1,0 +1,32 @@
+# Standalone build against an installed ITK, with plain CMake.
+include(GNUInstallDirs)
+include(CTest)
+
+set(EDM_ITK_COMPONENTS
+  ITKCommon ITKMesh ITKImageGradient ITKImageFilterBase ITKImageIntensity ITKSmoothing
+  ITKIOImageBase ITKIOMeshBase ITKIOMeshVTK ITKIOMeshOBJ ITKIOMeshOFF ITKIOMeshGifti
+  ITKIONIFTI ITKIONRRD ITKIOMeta ITKIOGDCM ITKIOPNG)
+find_package(ITK 5.2 REQUIRED COMPONENTS ${EDM_ITK_COMPONENTS})
+include(${ITK_USE_FILE})
+
+# The core is header-only templates.
+add_library(ExplicitDeformableModel INTERFACE)
+add_library(ExplicitDeformableModel::ExplicitDeformableModel ALIAS ExplicitDeformableModel)
+target_include_directories(ExplicitDeformableModel INTERFACE
+  $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include>
+  $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/ExplicitDeformableModel>)
+target_link_libraries(ExplicitDeformableModel INTERFACE ${ITK_LIBRARIES})
+install(DIRECTORY include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/ExplicitDeformableModel)
+
+set(CMAKE_RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/bin)
+
+if(EXISTS ${PROJECT_SOURCE_DIR}/src/CMakeLists.txt)
+  add_subdirectory(src)
+endif()
+if(BUILD_TESTING)
+  add_subdirectory(test)
+endif()
+option(EDM_BUILD_EXAMPLES "Build the examples" ON)
+if(EDM_BUILD_EXAMPLES)
+  add_subdirectory(examples)
+endif()

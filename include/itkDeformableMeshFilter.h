@@ -1,0 +1,288 @@
+/*=========================================================================
+ *
+ *  Copyright NumFOCUS
+ *
+ *  Licensed under the Apache License, Version 2.0 (the "License");
+ *  you may not use this file except in compliance with the License.
+ *  You may obtain a copy of the License at
+ *
+ *         http://www.apache.org/licenses/LICENSE-2.0.txt
+ *
+ *  Unless required by applicable law or agreed to in writing, software
+ *  distributed under the License is distributed on an "AS IS" BASIS,
+ *  WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+ *  See the License for the specific language governing permissions and
+ *  limitations under the License.
+ *
+ *=========================================================================*/
+#ifndef itkDeformableMeshFilter_h
+#define itkDeformableMeshFilter_h
+
+#include "itkIterativeMeshFilter.h"
+#include "itkImage.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace itk
+{
+
+/** \class DeformableMeshFilter
+ * \brief Explicit deformable surface: the points of a mesh move, iteration after
+ * iteration, under an external force field sampled from an image and internal
+ * forces that keep the surface regular.
+ *
+ * At each iteration every vertex \f$ x_i \f$ moves by
+ * \f[
+ *   \Delta x_i = s\,F(x_i) + a\,E_i + b\,R_i + \beta\,n_i
+ * \f]
+ * where
+ * - \f$ F \f$ is the force image sampled by trilinear interpolation at the
+ *   physical position of the vertex (origin, spacing and direction of the
+ *   image honoured; a vertex outside the image gets no external force),
+ *   \f$ s \f$ the ScaleFactor;
+ * - \f$ E_i = \bar{x}_{N(i)} - x_i \f$ is the elastic (membrane) force toward the
+ *   centroid of the vertex's neighbours, projected on the tangent plane when
+ *   TangentialElasticity is on, \f$ a \f$ the Elasticity;
+ * - \f$ R_i = -(\overline{E}_{N(i)} - E_i) \f$ is the rigidity (bending) force,
+ *   the negated umbrella operator applied twice, \f$ b \f$ the Rigidity;
+ * - \f$ n_i \f$ is the outward unit vertex normal and \f$ \beta \f$ the Balloon
+ *   (Cohen's inflation force).
+ *
+ * The neighbours come from the mesh's cells (edges of triangles, polygons, lines
+ * and polylines); normals from its triangles and polygons. The explicit update
+ * of the internal terms is stable when \f$ a + 2b \le 1 \f$; larger sums are
+ * scaled down to 1 so that every valid parameter set gives a stable iteration.
+ * MaximumStepLength, when positive, bounds the length of each vertex's
+ * displacement per iteration.
+ *
+ * With the output of ExternalForceImageFilter (normalised so that the largest
+ * force has length 1), ScaleFactor is the largest external displacement per
+ * iteration in physical units, whatever the intensity range of the image.
+ *
+ * Convergence: with ConvergenceTolerance > 0, the iteration stops when the
+ * largest vertex displacement stays below the tolerance during
+ * ConvergenceWindow consecutive iterations; GetConverged() then returns true
+ * and CurrentIteration tells where it stopped. NumberOfIterations remains the
+ * cap.
+ *
+ * The step runs on flat arrays unpacked once in Reset(): coordinates, a CSR
+ * vertex-neighbour table and a vertex-triangle table; the force image is read
+ * through its buffer with the physical-to-index transform precomputed. Vertices
+ * are processed in fixed blocks over threads, so the output is bit-for-bit
+ * identical whatever the number of threads.
+ *
+ * Per-vertex diagnostics of the last iteration (displacement length, external
+ * and internal force lengths, physical units) are available with
+ * GetDisplacementMagnitudes(), GetExternalForceMagnitudes() and
+ * GetInternalForceMagnitudes().
+ *
+ * \sa ExternalForceImageFilter, IterativeMeshFilter
+ * \ingroup ExplicitDeformableModel
+ */
+template<typename TMesh, typename TForceImage>
+class ITK_TEMPLATE_EXPORT DeformableMeshFilter : public IterativeMeshFilter<TMesh, TMesh>
+{
+public:
+  ITK_DISALLOW_COPY_AND_MOVE(DeformableMeshFilter);
+
+  /** Standard class type aliases. */
+  using Self = DeformableMeshFilter;
+  using Superclass = IterativeMeshFilter<TMesh, TMesh>;
+  using Pointer = SmartPointer<Self>;
+  using ConstPointer = SmartPointer<const Self>;
+
+  /** Method for creation through the object factory. */
+  itkNewMacro(Self);
+
+  /** Run-time type information (and related methods). */
+  itkTypeMacro(DeformableMeshFilter, IterativeMeshFilter);
+
+  using MeshType = TMesh;
+  using ForceImageType = TForceImage;
+  using ForcePixelType = typename ForceImageType::PixelType;
+
+  static constexpr unsigned int PointDimension = Superclass::PointDimension;
+  static_assert(PointDimension == 3, "DeformableMeshFilter deforms 3-D meshes.");
+  static_assert(ForceImageType::ImageDimension == 3, "The force image must be 3-D.");
+  static_assert(ForcePixelType::Dimension == 3, "The force image pixels must have 3 components.");
+
+  /** The external force field: a 3-D image of 3-component vectors
+   * (itk::Vector or itk::CovariantVector, float or double) expressed in
+   * physical space, for example the output of ExternalForceImageFilter.
+   * Required. */
+  itkSetInputMacro(ForceImage, ForceImageType);
+  itkGetInputMacro(ForceImage, ForceImageType);
+
+  /** Weight s of the external force: a vertex moves by s times the sampled
+   * force per iteration. With a force field normalised to a largest length of 1
+   * (ExternalForceImageFilter's default), s is the largest external
+   * displacement per iteration in physical units; keep it below the smoothing
+   * scale of the force field for a smooth approach (about half of it).
+   * Must be finite. Default: 1.0. */
+  itkSetMacro(ScaleFactor, double);
+  itkGetConstMacro(ScaleFactor, double);
+
+  /** Weight a of the elastic (membrane, first order) internal force, pulling
+   * each vertex toward the centroid of its neighbours. Dimensionless, in
+   * [0, 1]: 1 moves a vertex onto the centroid in one iteration. Default: 0
+   * (vertices move independently, as in the seed's deformable mesh). */
+  itkSetMacro(Elasticity, double);
+  itkGetConstMacro(Elasticity, double);
+
+  /** When on (default), the elastic force keeps only its component tangent to
+   * the surface: it regularises the distribution of the vertices without
+   * shrinking the surface. When off, the full umbrella operator is used
+   * (Laplacian smoothing, which also shrinks convex surfaces). */
+  itkSetMacro(TangentialElasticity, bool);
+  itkGetConstMacro(TangentialElasticity, bool);
+  itkBooleanMacro(TangentialElasticity);
+
+  /** Weight b of the rigidity (bending, second order) internal force, the
+   * umbrella operator applied twice: it penalises changes of curvature and
+   * leaves a sphere unchanged. Dimensionless, in [0, 0.5] for stability on its
+   * own; a + 2b above 1 is scaled down to 1. Default: 0. */
+  itkSetMacro(Rigidity, double);
+  itkGetConstMacro(Rigidity, double);
+
+  /** Balloon (inflation) force: displacement along the outward unit vertex
+   * normal per iteration, in physical units. Positive inflates, negative
+   * deflates. "Outward" is decided from the signed volume of the mesh, so an
+   * inward-oriented closed mesh behaves the same as an outward-oriented one.
+   * Must be finite. Default: 0. */
+  itkSetMacro(Balloon, double);
+  itkGetConstMacro(Balloon, double);
+
+  /** Upper bound on the length of a vertex's displacement per iteration, in
+   * physical units; 0 means no bound. Useful with raw (unnormalised) force
+   * fields. Must be finite and non-negative. Default: 0. */
+  itkSetMacro(MaximumStepLength, double);
+  itkGetConstMacro(MaximumStepLength, double);
+
+  /** Convergence threshold on the largest vertex displacement of an
+   * iteration, in physical units; 0 disables convergence detection.
+   * Must be finite and non-negative. Default: 0. */
+  itkSetMacro(ConvergenceTolerance, double);
+  itkGetConstMacro(ConvergenceTolerance, double);
+
+  /** Number of consecutive iterations whose largest displacement must stay
+   * below ConvergenceTolerance to declare convergence. At least 1.
+   * Default: 5. */
+  itkSetClampMacro(ConvergenceWindow, unsigned int, 1, NumericTraits<unsigned int>::max());
+  itkGetConstMacro(ConvergenceWindow, unsigned int);
+
+  /** True when the last update stopped because of convergence. */
+  itkGetConstMacro(Converged, bool);
+
+  /** Largest vertex displacement of the last iteration, physical units. */
+  itkGetConstMacro(LastMaximumDisplacement, double);
+
+  /** Per-vertex diagnostics of the last iteration, indexed by point
+   * identifier, physical units: displacement length, external force
+   * contribution s|F| and internal force contribution |aE + bR|. Empty before
+   * the first iteration. */
+  const std::vector<float> &
+  GetDisplacementMagnitudes() const
+  {
+    return m_DisplacementMagnitudes;
+  }
+  const std::vector<float> &
+  GetExternalForceMagnitudes() const
+  {
+    return m_ExternalForceMagnitudes;
+  }
+  const std::vector<float> &
+  GetInternalForceMagnitudes() const
+  {
+    return m_InternalForceMagnitudes;
+  }
+
+  /** Sign applied to the triangles' orientation to get outward normals: +1 for
+   * an outward-oriented mesh, -1 for an inward-oriented one. Set by Reset(). */
+  itkGetConstMacro(OrientationSign, double);
+
+protected:
+  DeformableMeshFilter();
+  ~DeformableMeshFilter() override = default;
+
+  void
+  PrintSelf(std::ostream & os, Indent indent) const override;
+
+  void
+  VerifyPreconditions() ITKv5_CONST override;
+
+  void
+  GenerateData() override;
+
+  void
+  Reset() override;
+
+  void
+  Iterate() override;
+
+  bool
+  HasConverged() const override
+  {
+    return m_Converged;
+  }
+
+private:
+  using IndexType32 = uint32_t;
+
+  void
+  BuildTopology();
+
+  void
+  PrepareForceSampler();
+
+  /** Trilinear sample of the force image at physical point x; false (and a zero
+   * force) outside the image. */
+  inline bool
+  SampleForce(const double * x, double * force) const;
+
+  /** Outward (area-weighted, normalised) normal of vertex i. */
+  inline void
+  ComputeNormal(const double * coordinates, SizeValueType i, double * normal) const;
+
+  double       m_ScaleFactor{ 1.0 };
+  double       m_Elasticity{ 0.0 };
+  bool         m_TangentialElasticity{ true };
+  double       m_Rigidity{ 0.0 };
+  double       m_Balloon{ 0.0 };
+  double       m_MaximumStepLength{ 0.0 };
+  double       m_ConvergenceTolerance{ 0.0 };
+  unsigned int m_ConvergenceWindow{ 5 };
+
+  bool         m_Converged{ false };
+  unsigned int m_QuietIterations{ 0 };
+  double       m_LastMaximumDisplacement{ 0.0 };
+  double       m_OrientationSign{ 1.0 };
+
+  // Topology, unpacked once per Reset().
+  std::vector<IndexType32> m_NeighbourOffsets;
+  std::vector<IndexType32> m_Neighbours;
+  std::vector<IndexType32> m_Triangles;
+  std::vector<IndexType32> m_VertexTriangleOffsets;
+  std::vector<IndexType32> m_VertexTriangles;
+
+  // Per-vertex state.
+  std::vector<double> m_NextCoordinates;
+  std::vector<double> m_Umbrella;
+  std::vector<float>  m_DisplacementMagnitudes;
+  std::vector<float>  m_ExternalForceMagnitudes;
+  std::vector<float>  m_InternalForceMagnitudes;
+
+  // Force sampler, prepared at each update.
+  const ForcePixelType * m_ForceBuffer{ nullptr };
+  double                 m_PhysicalToIndex[3][3]{};
+  double                 m_ForceOrigin[3]{};
+  double                 m_BufferStart[3]{};
+  int64_t                m_BufferSize[3]{};
+};
+} // end namespace itk
+
+#ifndef ITK_MANUAL_INSTANTIATION
+#  include "itkDeformableMeshFilter.hxx"
+#endif
+
+#endif

@@ -1,0 +1,226 @@
+/*=========================================================================
+ *
+ *  Copyright NumFOCUS
+ *
+ *  Licensed under the Apache License, Version 2.0 (the "License");
+ *  you may not use this file except in compliance with the License.
+ *  You may obtain a copy of the License at
+ *
+ *         http://www.apache.org/licenses/LICENSE-2.0.txt
+ *
+ *  Unless required by applicable law or agreed to in writing, software
+ *  distributed under the License is distributed on an "AS IS" BASIS,
+ *  WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+ *  See the License for the specific language governing permissions and
+ *  limitations under the License.
+ *
+ *=========================================================================*/
+#ifndef itkEllipsoidPhantom_h
+#define itkEllipsoidPhantom_h
+
+#include "itkImage.h"
+#include "itkImageRegionIteratorWithIndex.h"
+#include "itkMatrix.h"
+#include "itkRegularSphereMeshSource.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace itk
+{
+
+/** \class EllipsoidPhantom
+ * \brief An ellipsoid in physical space, with the tools to test a deformable
+ * model against it: a binary image of it, a sphere mesh to start from, and
+ * the exact Euclidean distance from a point to its surface.
+ *
+ * The ellipsoid is \f$ \{ c + A y : \sum_k (y_k / r_k)^2 \le 1 \} \f$ with
+ * centre c, semi-axes r (physical units) and an orthonormal axis matrix A whose
+ * columns are the ellipsoid's axes (identity by default).
+ *
+ * \ingroup ExplicitDeformableModel
+ */
+class EllipsoidPhantom
+{
+public:
+  using PointType = Point<double, 3>;
+  using VectorType = Vector<double, 3>;
+  using MatrixType = Matrix<double, 3, 3>;
+
+  EllipsoidPhantom(const PointType &  center,
+                   const VectorType & radii,
+                   const MatrixType & axes = MatrixType::GetIdentity())
+    : m_Center(center)
+    , m_Radii(radii)
+    , m_Axes(axes)
+  {}
+
+  const PointType &
+  GetCenter() const
+  {
+    return m_Center;
+  }
+  const VectorType &
+  GetRadii() const
+  {
+    return m_Radii;
+  }
+  const MatrixType &
+  GetAxes() const
+  {
+    return m_Axes;
+  }
+
+  /** Coordinates of p in the ellipsoid's frame. */
+  VectorType
+  ToLocal(const PointType & p) const
+  {
+    VectorType local;
+    for (unsigned int i = 0; i < 3; ++i)
+    {
+      local[i] = 0.0;
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        local[i] += m_Axes(k, i) * (p[k] - m_Center[k]);
+      }
+    }
+    return local;
+  }
+
+  bool
+  IsInside(const PointType & p) const
+  {
+    const VectorType y = this->ToLocal(p);
+    double           s = 0.0;
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      s += (y[k] / m_Radii[k]) * (y[k] / m_Radii[k]);
+    }
+    return s <= 1.0;
+  }
+
+  /** Euclidean distance from p to the ellipsoid's surface (physical units),
+   * by bisection on the Lagrange multiplier of the closest-point problem. */
+  double
+  DistanceToSurface(const PointType & p) const
+  {
+    const VectorType y = this->ToLocal(p);
+    double           z[3];
+    double           a2[3];
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      z[k] = std::abs(y[k]);
+      a2[k] = m_Radii[k] * m_Radii[k];
+    }
+    // g(t) = sum (a_k z_k / (t + a_k^2))^2 - 1 decreases on (-min a^2, inf).
+    auto g = [&](double t) {
+      double s = 0.0;
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        const double q = m_Radii[k] * z[k] / (t + a2[k]);
+        s += q * q;
+      }
+      return s - 1.0;
+    };
+    const double smallest = std::min({ a2[0], a2[1], a2[2] });
+    const double norm = std::sqrt(z[0] * z[0] + z[1] * z[1] + z[2] * z[2]);
+    double       low = -smallest;
+    double       high = std::sqrt(std::max({ a2[0], a2[1], a2[2] })) * norm + 1.0;
+    for (int iteration = 0; iteration < 200; ++iteration)
+    {
+      const double middle = 0.5 * (low + high);
+      if (middle <= -smallest || g(middle) > 0.0)
+      {
+        low = middle;
+      }
+      else
+      {
+        high = middle;
+      }
+    }
+    const double t = 0.5 * (low + high);
+    double       d2 = 0.0;
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      const double denominator = t + a2[k];
+      const double closest = denominator > 0.0 ? a2[k] * z[k] / denominator : m_Radii[k];
+      d2 += (z[k] - std::min(closest, m_Radii[k])) * (z[k] - std::min(closest, m_Radii[k]));
+    }
+    return std::sqrt(d2);
+  }
+
+  /** Binary image of the ellipsoid: voxels whose centre is inside get
+   * \a inside, the others \a outside. */
+  template<typename TImage>
+  typename TImage::Pointer
+  MakeImage(const typename TImage::SizeType &      size,
+            const typename TImage::SpacingType &   spacing,
+            const typename TImage::PointType &     origin,
+            const typename TImage::DirectionType & direction,
+            typename TImage::PixelType             inside = 1,
+            typename TImage::PixelType             outside = 0) const
+  {
+    auto image = TImage::New();
+    image->SetRegions(size);
+    image->SetSpacing(spacing);
+    image->SetOrigin(origin);
+    image->SetDirection(direction);
+    image->Allocate();
+    for (ImageRegionIteratorWithIndex<TImage> it(image, image->GetBufferedRegion()); !it.IsAtEnd(); ++it)
+    {
+      typename TImage::PointType p;
+      image->TransformIndexToPhysicalPoint(it.GetIndex(), p);
+      PointType q;
+      q.CastFrom(p);
+      it.Set(this->IsInside(q) ? inside : outside);
+    }
+    return image;
+  }
+
+  /** Mean and largest distance of a mesh's points to the surface. */
+  template<typename TMesh>
+  void
+  MeasureDistance(const TMesh * mesh, double & meanDistance, double & maximumDistance) const
+  {
+    meanDistance = 0.0;
+    maximumDistance = 0.0;
+    const auto * points = mesh->GetPoints();
+    for (auto it = points->Begin(); it != points->End(); ++it)
+    {
+      PointType p;
+      p.CastFrom(it.Value());
+      const double d = this->DistanceToSurface(p);
+      meanDistance += d;
+      maximumDistance = std::max(maximumDistance, d);
+    }
+    meanDistance /= std::max<double>(1.0, static_cast<double>(points->Size()));
+  }
+
+private:
+  PointType  m_Center;
+  VectorType m_Radii;
+  MatrixType m_Axes;
+};
+
+/** A triangulated sphere (icosahedron subdivided \a resolution times:
+ * 10 * 4^resolution + 2 points) of the given centre and radius. */
+template<typename TMesh>
+typename TMesh::Pointer
+MakeSphereMesh(const typename TMesh::PointType & center, double radius, unsigned int resolution = 4)
+{
+  using SourceType = RegularSphereMeshSource<TMesh>;
+  auto                            source = SourceType::New();
+  typename SourceType::VectorType scale;
+  scale.Fill(radius);
+  source->SetCenter(center);
+  source->SetScale(scale);
+  source->SetResolution(resolution);
+  source->Update();
+  typename TMesh::Pointer mesh = source->GetOutput();
+  mesh->DisconnectPipeline();
+  return mesh;
+}
+
+} // end namespace itk
+
+#endif

@@ -1,0 +1,288 @@
+/*=========================================================================
+ *
+ *  Copyright NumFOCUS
+ *
+ *  Licensed under the Apache License, Version 2.0 (the "License");
+ *  you may not use this file except in compliance with the License.
+ *  You may obtain a copy of the License at
+ *
+ *         http://www.apache.org/licenses/LICENSE-2.0.txt
+ *
+ *  Unless required by applicable law or agreed to in writing, software
+ *  distributed under the License is distributed on an "AS IS" BASIS,
+ *  WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+ *  See the License for the specific language governing permissions and
+ *  limitations under the License.
+ *
+ *=========================================================================*/
+#ifndef itkExternalForceImageFilter_hxx
+#define itkExternalForceImageFilter_hxx
+
+#include "itkExternalForceImageFilter.h"
+#include "itkCastImageFilter.h"
+#include "itkGradientMagnitudeImageFilter.h"
+#include "itkImageAlgorithm.h"
+#include "itkMultiThreaderBase.h"
+#include "itkProgressAccumulator.h"
+#include "itkSmoothingRecursiveGaussianImageFilter.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace itk
+{
+
+template<typename TInputImage, typename TOutputImage>
+void
+ExternalForceImageFilter<TInputImage, TOutputImage>::VerifyPreconditions() ITKv5_CONST
+{
+  Superclass::VerifyPreconditions();
+  if (!(m_Sigma >= 0.0 && std::isfinite(m_Sigma)))
+  {
+    itkExceptionMacro("Sigma must be finite and non-negative; it is " << m_Sigma << ".");
+  }
+  if (m_UseGradientVectorFlow &&
+      !(m_GradientVectorFlowRegularization > 0.0 && std::isfinite(m_GradientVectorFlowRegularization)))
+  {
+    itkExceptionMacro("GradientVectorFlowRegularization must be positive and finite; it is "
+                      << m_GradientVectorFlowRegularization << ".");
+  }
+}
+
+template<typename TInputImage, typename TOutputImage>
+void
+ExternalForceImageFilter<TInputImage, TOutputImage>::GenerateInputRequestedRegion()
+{
+  auto * input = const_cast<InputImageType *>(this->GetInput());
+  if (input != nullptr)
+  {
+    input->SetRequestedRegionToLargestPossibleRegion();
+  }
+}
+
+template<typename TInputImage, typename TOutputImage>
+void
+ExternalForceImageFilter<TInputImage, TOutputImage>::EnlargeOutputRequestedRegion(DataObject * output)
+{
+  output->SetRequestedRegionToLargestPossibleRegion();
+}
+
+template<typename TInputImage, typename TOutputImage>
+void
+ExternalForceImageFilter<TInputImage, TOutputImage>::GenerateData()
+{
+  const InputImageType * input = this->GetInput();
+  if (input->GetBufferedRegion().GetNumberOfPixels() == 0)
+  {
+    itkExceptionMacro("The input image has no pixel in its buffered region.");
+  }
+  for (unsigned int d = 0; d < ImageDimension; ++d)
+  {
+    if (input->GetLargestPossibleRegion().GetSize()[d] < 4)
+    {
+      itkExceptionMacro("The input image must have at least 4 pixels along each axis; its size is "
+                        << input->GetLargestPossibleRegion().GetSize() << ".");
+    }
+  }
+
+  auto progress = ProgressAccumulator::New();
+  progress->SetMiniPipelineFilter(this);
+
+  using CastType = CastImageFilter<InputImageType, RealImageType>;
+  auto cast = CastType::New();
+  cast->SetInput(input);
+  cast->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
+  progress->RegisterInternalFilter(cast, 0.1f);
+  typename RealImageType::Pointer smoothed;
+  if (m_Sigma > 0.0)
+  {
+    using SmoothingType = SmoothingRecursiveGaussianImageFilter<RealImageType, RealImageType>;
+    auto smoothing = SmoothingType::New();
+    smoothing->SetInput(cast->GetOutput());
+    smoothing->SetSigma(m_Sigma);
+    smoothing->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
+    progress->RegisterInternalFilter(smoothing, 0.3f);
+    smoothing->Update();
+    smoothed = smoothing->GetOutput();
+  }
+  else
+  {
+    cast->Update();
+    smoothed = cast->GetOutput();
+  }
+  smoothed->DisconnectPipeline();
+
+  using MagnitudeType = GradientMagnitudeImageFilter<RealImageType, RealImageType>;
+  auto magnitude = MagnitudeType::New();
+  magnitude->SetInput(smoothed);
+  magnitude->SetUseImageSpacing(this->GetUseImageSpacing());
+  magnitude->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
+  progress->RegisterInternalFilter(magnitude, 0.2f);
+  magnitude->Update();
+  typename RealImageType::Pointer edgeMap = magnitude->GetOutput();
+  edgeMap->DisconnectPipeline();
+  smoothed = nullptr;
+
+  if (m_UseGradientVectorFlow)
+  {
+    // A [0, 1] edge map makes the GVF weights independent of the intensity range.
+    float *             e = edgeMap->GetBufferPointer();
+    const SizeValueType n = edgeMap->GetBufferedRegion().GetNumberOfPixels();
+    const float         largest = *std::max_element(e, e + n);
+    if (largest > 0.0f)
+    {
+      std::transform(e, e + n, e, [largest](float v) { return v / largest; });
+    }
+  }
+
+  using ForceGradientType = GradientImageFilter<RealImageType, OutputValueType, OutputValueType, OutputImageType>;
+  auto gradient = ForceGradientType::New();
+  gradient->SetInput(edgeMap);
+  gradient->SetUseImageSpacing(this->GetUseImageSpacing());
+  gradient->SetUseImageDirection(this->GetUseImageDirection());
+  gradient->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
+  progress->RegisterInternalFilter(gradient, 0.2f);
+  gradient->Update();
+  typename OutputImageType::Pointer field = gradient->GetOutput();
+  field->DisconnectPipeline();
+
+  if (m_UseGradientVectorFlow)
+  {
+    this->DiffuseGradientVectorFlow(field);
+  }
+
+  if (m_NormalizeForces)
+  {
+    OutputPixelType *   f = field->GetBufferPointer();
+    const SizeValueType n = field->GetBufferedRegion().GetNumberOfPixels();
+    double              largest = 0.0;
+    for (SizeValueType i = 0; i < n; ++i)
+    {
+      largest = std::max(largest, static_cast<double>(f[i].GetSquaredNorm()));
+    }
+    if (largest > 0.0)
+    {
+      const auto scale = static_cast<OutputValueType>(1.0 / std::sqrt(largest));
+      for (SizeValueType i = 0; i < n; ++i)
+      {
+        f[i] *= scale;
+      }
+    }
+  }
+  this->GraftOutput(field);
+}
+
+template<typename TInputImage, typename TOutputImage>
+void
+ExternalForceImageFilter<TInputImage, TOutputImage>::DiffuseGradientVectorFlow(OutputImageType * field)
+{
+  constexpr unsigned int Components = OutputPixelType::Dimension;
+  const auto             region = field->GetBufferedRegion();
+  const auto             size = region.GetSize();
+  const SizeValueType    numberOfPixels = region.GetNumberOfPixels();
+  const SizeValueType    lineLength = size[0];
+  const SizeValueType    numberOfLines = numberOfPixels / lineLength;
+
+  OffsetValueType stride[ImageDimension];
+  double          inverseSquaredSpacing[ImageDimension];
+  double          sumInverseSquaredSpacing = 0.0;
+  stride[0] = 1;
+  for (unsigned int d = 0; d < ImageDimension; ++d)
+  {
+    if (d > 0)
+    {
+      stride[d] = stride[d - 1] * static_cast<OffsetValueType>(size[d - 1]);
+    }
+    const double h = this->GetUseImageSpacing() ? field->GetSpacing()[d] : 1.0;
+    inverseSquaredSpacing[d] = 1.0 / (h * h);
+    sumInverseSquaredSpacing += inverseSquaredSpacing[d];
+  }
+
+  // Data term: b = |grad e|^2 and c = b * grad e, from the initial field.
+  const OutputPixelType *      f = field->GetBufferPointer();
+  std::vector<float>           b(numberOfPixels);
+  std::vector<OutputPixelType> c(numberOfPixels);
+  float                        largestB = 0.0f;
+  for (SizeValueType i = 0; i < numberOfPixels; ++i)
+  {
+    b[i] = static_cast<float>(f[i].GetSquaredNorm());
+    c[i] = f[i] * static_cast<OutputValueType>(b[i]);
+    largestB = std::max(largestB, b[i]);
+  }
+
+  // Forward Euler is stable for dt * (4 mu sum(1/h^2) + max b) <= 2.
+  const double mu = m_GradientVectorFlowRegularization;
+  const double timeStep = 0.9 * 2.0 / (4.0 * mu * sumInverseSquaredSpacing + largestB);
+
+  std::vector<OutputPixelType> current(f, f + numberOfPixels);
+  std::vector<OutputPixelType> next(numberOfPixels);
+  MultiThreaderBase *          threader = this->GetMultiThreader();
+  threader->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
+
+  for (unsigned int iteration = 0; iteration < m_GradientVectorFlowIterations; ++iteration)
+  {
+    const OutputPixelType * v = current.data();
+    OutputPixelType *       w = next.data();
+    threader->ParallelizeArray(
+      0,
+      numberOfLines,
+      [&](SizeValueType line) {
+        // Position of the line along the axes other than x.
+        SizeValueType   remainder = line;
+        OffsetValueType lineStart = 0;
+        bool            hasLower[ImageDimension];
+        bool            hasUpper[ImageDimension];
+        for (unsigned int d = 1; d < ImageDimension; ++d)
+        {
+          const SizeValueType coordinate = remainder % size[d];
+          remainder /= size[d];
+          lineStart += static_cast<OffsetValueType>(coordinate) * stride[d];
+          hasLower[d] = coordinate > 0;
+          hasUpper[d] = coordinate + 1 < size[d];
+        }
+        for (SizeValueType x = 0; x < lineLength; ++x)
+        {
+          const OffsetValueType   i = lineStart + static_cast<OffsetValueType>(x);
+          const OutputPixelType & center = v[i];
+          hasLower[0] = x > 0;
+          hasUpper[0] = x + 1 < lineLength;
+          double laplacian[Components] = {};
+          for (unsigned int d = 0; d < ImageDimension; ++d)
+          {
+            // Zero-flux (Neumann) boundary: a missing neighbour equals the centre.
+            const OutputPixelType & lower = hasLower[d] ? v[i - stride[d]] : center;
+            const OutputPixelType & upper = hasUpper[d] ? v[i + stride[d]] : center;
+            for (unsigned int k = 0; k < Components; ++k)
+            {
+              laplacian[k] += (static_cast<double>(lower[k]) + upper[k] - 2.0 * center[k]) * inverseSquaredSpacing[d];
+            }
+          }
+          for (unsigned int k = 0; k < Components; ++k)
+          {
+            w[i][k] =
+              static_cast<OutputValueType>(center[k] + timeStep * (mu * laplacian[k] - b[i] * center[k] + c[i][k]));
+          }
+        }
+      },
+      nullptr);
+    current.swap(next);
+    this->UpdateProgress(static_cast<float>(iteration + 1) / m_GradientVectorFlowIterations);
+  }
+  std::copy(current.begin(), current.end(), field->GetBufferPointer());
+}
+
+template<typename TInputImage, typename TOutputImage>
+void
+ExternalForceImageFilter<TInputImage, TOutputImage>::PrintSelf(std::ostream & os, Indent indent) const
+{
+  Superclass::PrintSelf(os, indent);
+  os << indent << "Sigma: " << m_Sigma << std::endl;
+  os << indent << "NormalizeForces: " << (m_NormalizeForces ? "On" : "Off") << std::endl;
+  os << indent << "UseGradientVectorFlow: " << (m_UseGradientVectorFlow ? "On" : "Off") << std::endl;
+  os << indent << "GradientVectorFlowRegularization: " << m_GradientVectorFlowRegularization << std::endl;
+  os << indent << "GradientVectorFlowIterations: " << m_GradientVectorFlowIterations << std::endl;
+}
+
+} // end namespace itk
+
+#endif

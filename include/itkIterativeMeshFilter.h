@@ -1,0 +1,176 @@
+/*=========================================================================
+ *
+ *  Copyright NumFOCUS
+ *
+ *  Licensed under the Apache License, Version 2.0 (the "License");
+ *  you may not use this file except in compliance with the License.
+ *  You may obtain a copy of the License at
+ *
+ *         http://www.apache.org/licenses/LICENSE-2.0.txt
+ *
+ *  Unless required by applicable law or agreed to in writing, software
+ *  distributed under the License is distributed on an "AS IS" BASIS,
+ *  WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+ *  See the License for the specific language governing permissions and
+ *  limitations under the License.
+ *
+ *=========================================================================*/
+#ifndef itkIterativeMeshFilter_h
+#define itkIterativeMeshFilter_h
+
+#include "itkMeshToMeshFilter.h"
+
+#include <vector>
+
+namespace itk
+{
+
+/** \class IterativeMeshFilter
+ * \brief Base class of mesh filters that move the points of a mesh step by step
+ * and can resume where the previous update stopped.
+ *
+ * The filter caches the coordinates of its input and transforms that cache one
+ * iteration at a time; the input mesh is never modified. The iteration contract:
+ *
+ * - On the first update, when IterateFromZero is on, when NumberOfIterations is 0,
+ *   when NumberOfIterations is below CurrentIteration, or when the input mesh
+ *   has changed since it was cached, the input coordinates are cached,
+ *   CurrentIteration returns to 0 and Reset() lets the subclass set its
+ *   initial state.
+ * - While CurrentIteration < NumberOfIterations (and the subclass has not
+ *   converged, see HasConverged()), Iterate() runs one step and CurrentIteration
+ *   increments. With IterateFromZero off, raising NumberOfIterations by one and
+ *   updating runs exactly one more step: this is what makes animation cheap.
+ * - NumberOfIterations == 0 gives the input back unchanged.
+ * - Each step invokes an IterationEvent; an observer reads the current mesh
+ *   with GetOutput(). Progress is reported after each step, and setting
+ *   AbortGenerateData stops the loop cleanly between two steps (the output then
+ *   holds the mesh of CurrentIteration; call Modified() before updating again to
+ *   resume).
+ *
+ * Cells, cell data and point data of the input are copied to the output; only
+ * point coordinates change. Point identifiers must be 0 to N-1 (the layout of
+ * the default VectorContainer-based meshes).
+ *
+ * Subclasses implement Iterate() on the coordinate cache (GetCoordinates(): a
+ * flat array of N * PointDimension doubles in physical units) and may override
+ * Reset() and HasConverged().
+ *
+ * \sa BrownianMeshFilter, DeformableMeshFilter
+ * \ingroup ExplicitDeformableModel
+ */
+template<typename TInputMesh, typename TOutputMesh = TInputMesh>
+class ITK_TEMPLATE_EXPORT IterativeMeshFilter : public MeshToMeshFilter<TInputMesh, TOutputMesh>
+{
+public:
+  ITK_DISALLOW_COPY_AND_MOVE(IterativeMeshFilter);
+
+  /** Standard class type aliases. */
+  using Self = IterativeMeshFilter;
+  using Superclass = MeshToMeshFilter<TInputMesh, TOutputMesh>;
+  using Pointer = SmartPointer<Self>;
+  using ConstPointer = SmartPointer<const Self>;
+
+  /** Run-time type information (and related methods). */
+  itkTypeMacro(IterativeMeshFilter, MeshToMeshFilter);
+
+  using InputMeshType = TInputMesh;
+  using OutputMeshType = TOutputMesh;
+  using OutputPointType = typename OutputMeshType::PointType;
+  using OutputPointsContainer = typename OutputMeshType::PointsContainer;
+
+  static constexpr unsigned int PointDimension = OutputMeshType::PointDimension;
+
+  /** Number of iterations the output should have undergone after the update.
+   * Default: 0 (the output is the input). With IterateFromZero off, only the
+   * iterations between CurrentIteration and NumberOfIterations are computed. */
+  itkSetMacro(NumberOfIterations, SizeValueType);
+  itkGetConstMacro(NumberOfIterations, SizeValueType);
+
+  /** Number of iterations the current output has undergone. It equals
+   * NumberOfIterations after a complete update, and is smaller when the update
+   * was aborted or the subclass detected convergence. */
+  itkGetConstMacro(CurrentIteration, SizeValueType);
+
+  /** When on (default), every update restarts from the input and runs all
+   * NumberOfIterations iterations. When off, an update continues from the mesh
+   * of the previous update: raising NumberOfIterations by one runs one step. */
+  itkSetMacro(IterateFromZero, bool);
+  itkGetConstMacro(IterateFromZero, bool);
+  itkBooleanMacro(IterateFromZero);
+
+protected:
+  IterativeMeshFilter();
+  ~IterativeMeshFilter() override = default;
+
+  void
+  PrintSelf(std::ostream & os, Indent indent) const override;
+
+  /** Rejects a missing input mesh with a clear message. */
+  void
+  VerifyPreconditions() ITKv5_CONST override;
+
+  /** Checks the input mesh (present, not empty, identifiers 0..N-1, finite
+   * coordinates), then runs the iteration contract described above. */
+  void
+  GenerateData() override;
+
+  /** Called after the input coordinates have been cached and CurrentIteration
+   * set to 0: subclasses set up their initial state here. Default: nothing. */
+  virtual void
+  Reset()
+  {}
+
+  /** One step: transform GetCoordinates() in place. */
+  virtual void
+  Iterate() = 0;
+
+  /** A subclass that detects convergence returns true to stop the loop before
+   * NumberOfIterations is reached. Default: false. */
+  virtual bool
+  HasConverged() const
+  {
+    return false;
+  }
+
+  /** The cached coordinates: N * PointDimension doubles, point after point. */
+  std::vector<double> &
+  GetCoordinates()
+  {
+    return m_Coordinates;
+  }
+  const std::vector<double> &
+  GetCoordinates() const
+  {
+    return m_Coordinates;
+  }
+
+  /** Number of points of the cached mesh. */
+  SizeValueType
+  GetNumberOfCachedPoints() const
+  {
+    return m_Coordinates.size() / PointDimension;
+  }
+
+  /** Writes the cached coordinates into the output mesh points. */
+  void
+  UpdateOutputPoints();
+
+private:
+  void
+  CacheInput();
+
+  SizeValueType       m_NumberOfIterations{ 0 };
+  SizeValueType       m_CurrentIteration{ 0 };
+  bool                m_IterateFromZero{ true };
+  bool                m_Cached{ false };
+  ModifiedTimeType    m_CachedInputTime{ 0 };
+  std::vector<double> m_Coordinates;
+};
+} // end namespace itk
+
+#ifndef ITK_MANUAL_INSTANTIATION
+#  include "itkIterativeMeshFilter.hxx"
+#endif
+
+#endif

@@ -1,0 +1,162 @@
+/*=========================================================================
+ *
+ *  Copyright NumFOCUS
+ *
+ *  Licensed under the Apache License, Version 2.0 (the "License");
+ *  you may not use this file except in compliance with the License.
+ *  You may obtain a copy of the License at
+ *
+ *         http://www.apache.org/licenses/LICENSE-2.0.txt
+ *
+ *  Unless required by applicable law or agreed to in writing, software
+ *  distributed under the License is distributed on an "AS IS" BASIS,
+ *  WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+ *  See the License for the specific language governing permissions and
+ *  limitations under the License.
+ *
+ *=========================================================================*/
+#ifndef itkIterativeMeshFilter_hxx
+#define itkIterativeMeshFilter_hxx
+
+#include "itkIterativeMeshFilter.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace itk
+{
+
+template<typename TInputMesh, typename TOutputMesh>
+IterativeMeshFilter<TInputMesh, TOutputMesh>::IterativeMeshFilter() = default;
+
+template<typename TInputMesh, typename TOutputMesh>
+void
+IterativeMeshFilter<TInputMesh, TOutputMesh>::VerifyPreconditions() ITKv5_CONST
+{
+  if (this->GetInput() == nullptr)
+  {
+    itkExceptionMacro("No input mesh: call SetInput() before Update().");
+  }
+  Superclass::VerifyPreconditions();
+}
+
+template<typename TInputMesh, typename TOutputMesh>
+void
+IterativeMeshFilter<TInputMesh, TOutputMesh>::CacheInput()
+{
+  const InputMeshType * input = this->GetInput();
+  const auto *          points = input->GetPoints();
+  const SizeValueType   numberOfPoints = points->Size();
+
+  m_Coordinates.resize(numberOfPoints * PointDimension);
+  SizeValueType expectedId = 0;
+  for (auto it = points->Begin(); it != points->End(); ++it, ++expectedId)
+  {
+    if (it.Index() != expectedId)
+    {
+      itkExceptionMacro("The input mesh's point identifiers must run from 0 to N-1; point #"
+                        << expectedId << " has identifier " << it.Index() << ".");
+    }
+    const auto & p = it.Value();
+    for (unsigned int d = 0; d < PointDimension; ++d)
+    {
+      const double value = static_cast<double>(p[d]);
+      if (!std::isfinite(value))
+      {
+        itkExceptionMacro("The input mesh has a non-finite coordinate (NaN or infinity) at point #" << expectedId
+                                                                                                    << ".");
+      }
+      m_Coordinates[expectedId * PointDimension + d] = value;
+    }
+  }
+  m_CachedInputTime = std::max(input->GetMTime(), input->GetUpdateMTime());
+}
+
+template<typename TInputMesh, typename TOutputMesh>
+void
+IterativeMeshFilter<TInputMesh, TOutputMesh>::GenerateData()
+{
+  const InputMeshType * input = this->GetInput();
+  if (input == nullptr)
+  {
+    itkExceptionMacro("No input mesh: call SetInput() before Update().");
+  }
+  if (input->GetPoints() == nullptr || input->GetNumberOfPoints() == 0)
+  {
+    itkExceptionMacro("The input mesh is empty: it has no points.");
+  }
+
+  const ModifiedTimeType inputTime = std::max(input->GetMTime(), input->GetUpdateMTime());
+  const bool             restart = !m_Cached || m_IterateFromZero || m_NumberOfIterations == 0 ||
+                       m_NumberOfIterations < m_CurrentIteration || inputTime > m_CachedInputTime ||
+                       input->GetNumberOfPoints() != this->GetNumberOfCachedPoints();
+  if (restart)
+  {
+    m_Cached = false;
+    this->CacheInput();
+    m_CurrentIteration = 0;
+    this->Reset();
+    m_Cached = true;
+  }
+
+  // Structure first, so that an observer of IterationEvent sees a whole mesh.
+  this->CopyInputMeshToOutputMeshCells();
+  this->CopyInputMeshToOutputMeshCellData();
+  this->CopyInputMeshToOutputMeshPointData();
+  this->UpdateOutputPoints();
+
+  const SizeValueType firstIteration = m_CurrentIteration;
+  const double        iterationsToRun = static_cast<double>(m_NumberOfIterations) - firstIteration;
+  while (m_CurrentIteration < m_NumberOfIterations && !this->HasConverged())
+  {
+    this->Iterate();
+    ++m_CurrentIteration;
+    if (this->HasObserver(IterationEvent()))
+    {
+      this->UpdateOutputPoints();
+      this->InvokeEvent(IterationEvent());
+    }
+    this->UpdateProgress(static_cast<float>((m_CurrentIteration - firstIteration) / iterationsToRun));
+    if (this->GetAbortGenerateData())
+    {
+      break;
+    }
+  }
+  this->UpdateOutputPoints();
+}
+
+template<typename TInputMesh, typename TOutputMesh>
+void
+IterativeMeshFilter<TInputMesh, TOutputMesh>::UpdateOutputPoints()
+{
+  const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
+  auto                points = OutputPointsContainer::New();
+  points->Reserve(numberOfPoints);
+  const double * x = m_Coordinates.data();
+  for (SizeValueType i = 0; i < numberOfPoints; ++i, x += PointDimension)
+  {
+    OutputPointType & p = points->ElementAt(i);
+    for (unsigned int d = 0; d < PointDimension; ++d)
+    {
+      p[d] = static_cast<typename OutputPointType::ValueType>(x[d]);
+    }
+  }
+  this->GetOutput()->SetPoints(points);
+}
+
+template<typename TInputMesh, typename TOutputMesh>
+void
+IterativeMeshFilter<TInputMesh, TOutputMesh>::PrintSelf(std::ostream & os, Indent indent) const
+{
+  Superclass::PrintSelf(os, indent);
+  os << indent << "NumberOfIterations: " << m_NumberOfIterations << std::endl;
+  os << indent << "CurrentIteration: " << m_CurrentIteration << std::endl;
+  os << indent << "IterateFromZero: " << (m_IterateFromZero ? "On" : "Off") << std::endl;
+  os << indent << "Cached: " << (m_Cached ? "true" : "false") << std::endl;
+  os << indent << "CachedInputTime: " << m_CachedInputTime << std::endl;
+  os << indent << "Coordinates: " << this->GetNumberOfCachedPoints() << " cached points" << std::endl;
+}
+
+} // end namespace itk
+
+#endif
