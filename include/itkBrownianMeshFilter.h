@@ -41,7 +41,7 @@ namespace itk
  * \sa IterativeMeshFilter
  * \ingroup ExplicitDeformableModel
  */
-template<typename TMesh>
+template <typename TMesh>
 class ITK_TEMPLATE_EXPORT BrownianMeshFilter : public IterativeMeshFilter<TMesh, TMesh>
 {
 public:

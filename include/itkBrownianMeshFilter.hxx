@@ -46,7 +46,7 @@ ToUnitInterval(uint64_t z)
 }
 } // namespace BrownianMeshFilterDetail
 
-template<typename TMesh>
+template <typename TMesh>
 void
 BrownianMeshFilter<TMesh>::VerifyPreconditions() ITKv5_CONST
 {
@@ -57,7 +57,7 @@ BrownianMeshFilter<TMesh>::VerifyPreconditions() ITKv5_CONST
   }
 }
 
-template<typename TMesh>
+template <typename TMesh>
 void
 BrownianMeshFilter<TMesh>::Iterate()
 {
@@ -94,7 +94,7 @@ BrownianMeshFilter<TMesh>::Iterate()
   this->GetMultiThreader()->ParallelizeArray(0, numberOfBlocks, moveBlock, nullptr);
 }
 
-template<typename TMesh>
+template <typename TMesh>
 void
 BrownianMeshFilter<TMesh>::PrintSelf(std::ostream & os, Indent indent) const
 {

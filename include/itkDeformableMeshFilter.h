@@ -80,7 +80,7 @@ namespace itk
  * \sa ExternalForceImageFilter, IterativeMeshFilter
  * \ingroup ExplicitDeformableModel
  */
-template<typename TMesh, typename TForceImage>
+template <typename TMesh, typename TForceImage>
 class ITK_TEMPLATE_EXPORT DeformableMeshFilter : public IterativeMeshFilter<TMesh, TMesh>
 {
 public:

@@ -28,7 +28,7 @@
 namespace itk
 {
 
-template<typename TMesh, typename TForceImage>
+template <typename TMesh, typename TForceImage>
 DeformableMeshFilter<TMesh, TForceImage>::DeformableMeshFilter()
 {
   // The force image is checked in VerifyPreconditions() with a clearer message
@@ -36,7 +36,7 @@ DeformableMeshFilter<TMesh, TForceImage>::DeformableMeshFilter()
   this->SetNumberOfRequiredInputs(1);
 }
 
-template<typename TMesh, typename TForceImage>
+template <typename TMesh, typename TForceImage>
 void
 DeformableMeshFilter<TMesh, TForceImage>::VerifyPreconditions() ITKv5_CONST
 {
@@ -71,7 +71,7 @@ DeformableMeshFilter<TMesh, TForceImage>::VerifyPreconditions() ITKv5_CONST
   }
 }
 
-template<typename TMesh, typename TForceImage>
+template <typename TMesh, typename TForceImage>
 void
 DeformableMeshFilter<TMesh, TForceImage>::GenerateData()
 {
@@ -79,7 +79,7 @@ DeformableMeshFilter<TMesh, TForceImage>::GenerateData()
   Superclass::GenerateData();
 }
 
-template<typename TMesh, typename TForceImage>
+template <typename TMesh, typename TForceImage>
 void
 DeformableMeshFilter<TMesh, TForceImage>::PrepareForceSampler()
 {
@@ -114,7 +114,7 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareForceSampler()
   }
 }
 
-template<typename TMesh, typename TForceImage>
+template <typename TMesh, typename TForceImage>
 inline bool
 DeformableMeshFilter<TMesh, TForceImage>::SampleForce(const double * x, double * force) const
 {
@@ -170,7 +170,7 @@ DeformableMeshFilter<TMesh, TForceImage>::SampleForce(const double * x, double *
   return true;
 }
 
-template<typename TMesh, typename TForceImage>
+template <typename TMesh, typename TForceImage>
 void
 DeformableMeshFilter<TMesh, TForceImage>::BuildTopology()
 {
@@ -297,7 +297,7 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology()
   m_OrientationSign = volume < 0.0 ? -1.0 : 1.0;
 }
 
-template<typename TMesh, typename TForceImage>
+template <typename TMesh, typename TForceImage>
 void
 DeformableMeshFilter<TMesh, TForceImage>::Reset()
 {
@@ -313,7 +313,7 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
   m_LastMaximumDisplacement = 0.0;
 }
 
-template<typename TMesh, typename TForceImage>
+template <typename TMesh, typename TForceImage>
 inline void
 DeformableMeshFilter<TMesh, TForceImage>::ComputeNormal(const double * x, SizeValueType i, double * normal) const
 {
@@ -337,7 +337,7 @@ DeformableMeshFilter<TMesh, TForceImage>::ComputeNormal(const double * x, SizeVa
   normal[2] = n[2] * scale;
 }
 
-template<typename TMesh, typename TForceImage>
+template <typename TMesh, typename TForceImage>
 void
 DeformableMeshFilter<TMesh, TForceImage>::Iterate()
 {
@@ -525,7 +525,7 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   }
 }
 
-template<typename TMesh, typename TForceImage>
+template <typename TMesh, typename TForceImage>
 void
 DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent indent) const
 {

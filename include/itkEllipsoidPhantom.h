@@ -151,7 +151,7 @@ public:
 
   /** Binary image of the ellipsoid: voxels whose centre is inside get
    * \a inside, the others \a outside. */
-  template<typename TImage>
+  template <typename TImage>
   typename TImage::Pointer
   MakeImage(const typename TImage::SizeType &      size,
             const typename TImage::SpacingType &   spacing,
@@ -178,7 +178,7 @@ public:
   }
 
   /** Mean and largest distance of a mesh's points to the surface. */
-  template<typename TMesh>
+  template <typename TMesh>
   void
   MeasureDistance(const TMesh * mesh, double & meanDistance, double & maximumDistance) const
   {
@@ -204,7 +204,7 @@ private:
 
 /** A triangulated sphere (icosahedron subdivided \a resolution times:
  * 10 * 4^resolution + 2 points) of the given centre and radius. */
-template<typename TMesh>
+template <typename TMesh>
 typename TMesh::Pointer
 MakeSphereMesh(const typename TMesh::PointType & center, double radius, unsigned int resolution = 4)
 {

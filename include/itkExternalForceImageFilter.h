@@ -55,9 +55,9 @@ namespace itk
  * \sa DeformableMeshFilter, GradientImageFilter
  * \ingroup ExplicitDeformableModel
  */
-template<typename TInputImage,
-         typename TOutputImage =
-           Image<CovariantVector<float, TInputImage::ImageDimension>, TInputImage::ImageDimension>>
+template <typename TInputImage,
+          typename TOutputImage =
+            Image<CovariantVector<float, TInputImage::ImageDimension>, TInputImage::ImageDimension>>
 class ITK_TEMPLATE_EXPORT ExternalForceImageFilter
   : public GradientImageFilter<TInputImage,
                                typename TOutputImage::PixelType::ValueType,

@@ -32,7 +32,7 @@
 namespace itk
 {
 
-template<typename TInputImage, typename TOutputImage>
+template <typename TInputImage, typename TOutputImage>
 void
 ExternalForceImageFilter<TInputImage, TOutputImage>::VerifyPreconditions() ITKv5_CONST
 {
@@ -49,7 +49,7 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::VerifyPreconditions() ITKv5
   }
 }
 
-template<typename TInputImage, typename TOutputImage>
+template <typename TInputImage, typename TOutputImage>
 void
 ExternalForceImageFilter<TInputImage, TOutputImage>::GenerateInputRequestedRegion()
 {
@@ -60,14 +60,14 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::GenerateInputRequestedRegio
   }
 }
 
-template<typename TInputImage, typename TOutputImage>
+template <typename TInputImage, typename TOutputImage>
 void
 ExternalForceImageFilter<TInputImage, TOutputImage>::EnlargeOutputRequestedRegion(DataObject * output)
 {
   output->SetRequestedRegionToLargestPossibleRegion();
 }
 
-template<typename TInputImage, typename TOutputImage>
+template <typename TInputImage, typename TOutputImage>
 void
 ExternalForceImageFilter<TInputImage, TOutputImage>::GenerateData()
 {
@@ -172,7 +172,7 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::GenerateData()
   this->GraftOutput(field);
 }
 
-template<typename TInputImage, typename TOutputImage>
+template <typename TInputImage, typename TOutputImage>
 void
 ExternalForceImageFilter<TInputImage, TOutputImage>::DiffuseGradientVectorFlow(OutputImageType * field)
 {
@@ -271,7 +271,7 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::DiffuseGradientVectorFlow(O
   std::copy(current.begin(), current.end(), field->GetBufferPointer());
 }
 
-template<typename TInputImage, typename TOutputImage>
+template <typename TInputImage, typename TOutputImage>
 void
 ExternalForceImageFilter<TInputImage, TOutputImage>::PrintSelf(std::ostream & os, Indent indent) const
 {

@@ -59,7 +59,7 @@ namespace itk
  * \sa BrownianMeshFilter, DeformableMeshFilter
  * \ingroup ExplicitDeformableModel
  */
-template<typename TInputMesh, typename TOutputMesh = TInputMesh>
+template <typename TInputMesh, typename TOutputMesh = TInputMesh>
 class ITK_TEMPLATE_EXPORT IterativeMeshFilter : public MeshToMeshFilter<TInputMesh, TOutputMesh>
 {
 public:

@@ -26,10 +26,10 @@
 namespace itk
 {
 
-template<typename TInputMesh, typename TOutputMesh>
+template <typename TInputMesh, typename TOutputMesh>
 IterativeMeshFilter<TInputMesh, TOutputMesh>::IterativeMeshFilter() = default;
 
-template<typename TInputMesh, typename TOutputMesh>
+template <typename TInputMesh, typename TOutputMesh>
 void
 IterativeMeshFilter<TInputMesh, TOutputMesh>::VerifyPreconditions() ITKv5_CONST
 {
@@ -40,7 +40,7 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::VerifyPreconditions() ITKv5_CONST
   Superclass::VerifyPreconditions();
 }
 
-template<typename TInputMesh, typename TOutputMesh>
+template <typename TInputMesh, typename TOutputMesh>
 void
 IterativeMeshFilter<TInputMesh, TOutputMesh>::CacheInput()
 {
@@ -72,7 +72,7 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::CacheInput()
   m_CachedInputTime = std::max(input->GetMTime(), input->GetUpdateMTime());
 }
 
-template<typename TInputMesh, typename TOutputMesh>
+template <typename TInputMesh, typename TOutputMesh>
 void
 IterativeMeshFilter<TInputMesh, TOutputMesh>::GenerateData()
 {
@@ -125,7 +125,7 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::GenerateData()
   this->UpdateOutputPoints();
 }
 
-template<typename TInputMesh, typename TOutputMesh>
+template <typename TInputMesh, typename TOutputMesh>
 void
 IterativeMeshFilter<TInputMesh, TOutputMesh>::UpdateOutputPoints()
 {
@@ -144,7 +144,7 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::UpdateOutputPoints()
   this->GetOutput()->SetPoints(points);
 }
 
-template<typename TInputMesh, typename TOutputMesh>
+template <typename TInputMesh, typename TOutputMesh>
 void
 IterativeMeshFilter<TInputMesh, TOutputMesh>::PrintSelf(std::ostream & os, Indent indent) const
 {
