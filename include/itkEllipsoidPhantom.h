@@ -202,8 +202,9 @@ private:
   MatrixType m_Axes;
 };
 
-/** A triangulated sphere (icosahedron subdivided \a resolution times:
- * 10 * 4^resolution + 2 points) of the given centre and radius. */
+/** A triangulated sphere of the given centre and radius (physical units):
+ * itk::RegularSphereMeshSource's octahedron subdivided \a resolution times,
+ * 4^(resolution + 1) + 2 points (1026 for resolution 4). */
 template <typename TMesh>
 typename TMesh::Pointer
 MakeSphereMesh(const typename TMesh::PointType & center, double radius, unsigned int resolution = 4)

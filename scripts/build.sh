@@ -1,0 +1,21 @@
+#!/bin/sh
+# Installs what ExplicitDeformableModel needs on Debian 12 (as root, with
+# apt-get), then configures and builds it into build/.
+# Usage: scripts/build.sh [extra CMake arguments]
+set -eu
+cd "$(dirname "$0")/.."
+
+packages="cmake make g++ libinsighttoolkit5-dev libgtest-dev libbenchmark-dev"
+missing=""
+for p in $packages; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+  echo "Installing:$missing"
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends $missing
+fi
+
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@"
+cmake --build build -j2
