@@ -30,3 +30,11 @@ option(EDM_BUILD_EXAMPLES "Build the examples" ON)
 if(EDM_BUILD_EXAMPLES)
   add_subdirectory(examples)
 endif()
+
+# Optional VTK faces (vtk/): the VTK module, Python wrapping (import edmodel),
+# rendering examples. AUTO builds them when find_package(VTK) succeeds.
+set(EDM_USE_VTK AUTO CACHE STRING "Build the VTK module and Python wrapping: AUTO (when VTK is found), ON, OFF")
+set_property(CACHE EDM_USE_VTK PROPERTY STRINGS AUTO ON OFF)
+if(NOT EDM_USE_VTK STREQUAL "OFF")
+  add_subdirectory(vtk)
+endif()

@@ -1,0 +1,47 @@
+/*=========================================================================
+ *
+ *  Copyright NumFOCUS
+ *
+ *  Licensed under the Apache License, Version 2.0 (the "License");
+ *  you may not use this file except in compliance with the License.
+ *  You may obtain a copy of the License at
+ *
+ *         http://www.apache.org/licenses/LICENSE-2.0.txt
+ *
+ *  Unless required by applicable law or agreed to in writing, software
+ *  distributed under the License is distributed on an "AS IS" BASIS,
+ *  WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+ *  See the License for the specific language governing permissions and
+ *  limitations under the License.
+ *
+ *=========================================================================*/
+#ifndef vtkIterativePolyDataAlgorithmInternals_h
+#define vtkIterativePolyDataAlgorithmInternals_h
+
+#include "itkIterativeMeshFilter.h"
+#include "itkMesh.h"
+
+#include "vtkType.h"
+
+class vtkPolyData;
+
+/**
+ * The ITK side of a vtkIterativePolyDataAlgorithm (private header): the mesh
+ * type the VTK classes compute with, the ITK filter of the subclass, and the
+ * ITK mesh converted from the VTK input, kept while the input does not change
+ * so that the ITK filter can continue its iterations.
+ */
+class vtkIterativePolyDataAlgorithmInternals
+{
+public:
+  using MeshType = itk::Mesh<double, 3>;
+  using FilterType = itk::IterativeMeshFilter<MeshType, MeshType>;
+
+  FilterType::Pointer Filter;
+  MeshType::Pointer   InputMesh;
+  // Identity and modification time of the vtkPolyData InputMesh was made from.
+  const vtkPolyData * InputPolyData = nullptr;
+  vtkMTimeType        InputTime = 0;
+};
+
+#endif

@@ -1,0 +1,17 @@
+"""Explicit deformable models for VTK, computed by the ITK filters of
+ExplicitDeformableModel.
+
+Classes:
+  vtkPolyDataIterativeWarp   Brownian random walk of the points (StepLength, Seed)
+  vtkDeformableMesh          deformable surface pulled by a vector image (port 1)
+  vtkIterationSeriesWriter   every K-th iteration as .vtp plus a .pvd collection
+  vtkIterativePolyDataAlgorithm  their base class (NumberOfIterations,
+                             CurrentIteration, IterateFromZero)
+"""
+
+# The VTK modules the wrapped classes derive from, loaded first.
+import vtkmodules.vtkCommonCore  # noqa: F401
+import vtkmodules.vtkCommonDataModel  # noqa: F401
+import vtkmodules.vtkCommonExecutionModel  # noqa: F401
+
+from .ExplicitDeformableModelVTK import *  # noqa: F401,F403
