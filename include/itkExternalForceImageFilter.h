@@ -111,13 +111,13 @@ public:
 
   /** Regularisation weight mu of gradient vector flow (dimensionless, with the
    * edge map normalised to [0, 1]): larger values give smoother fields that
-   * reach farther. Must be positive and finite. Default: 0.2. */
+   * reach farther. Must be positive and finite. Default: 0.1. */
   itkSetMacro(GradientVectorFlowRegularization, double);
   itkGetConstMacro(GradientVectorFlowRegularization, double);
 
   /** Number of explicit diffusion iterations of gradient vector flow. The
    * distance the field spreads grows as the square root of this number.
-   * Default: 200. */
+   * Default: 400. */
   itkSetMacro(GradientVectorFlowIterations, unsigned int);
   itkGetConstMacro(GradientVectorFlowIterations, unsigned int);
 
@@ -149,8 +149,8 @@ private:
   double       m_Sigma{ 1.0 };
   bool         m_NormalizeForces{ true };
   bool         m_UseGradientVectorFlow{ false };
-  double       m_GradientVectorFlowRegularization{ 0.2 };
-  unsigned int m_GradientVectorFlowIterations{ 200 };
+  double       m_GradientVectorFlowRegularization{ 0.1 };
+  unsigned int m_GradientVectorFlowIterations{ 400 };
 };
 } // end namespace itk
 
