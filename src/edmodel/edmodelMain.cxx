@@ -1,0 +1,661 @@
+
+// edmodel: command-line face of the ExplicitDeformableModel filters.
+// This file parses the command line and prints the help; the ITK pipeline is
+// in edmodelPipeline.cxx, image and mesh files in edmodelIO.cxx.
+
+#include "edmodelOptions.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <functional>
+#include <iostream>
+#include <sstream>
+#include <vector>
+
+#ifndef EDM_VERSION
+#  define EDM_VERSION "unknown"
+#endif
+
+namespace edm
+{
+namespace
+{
+
+std::string
+FormatNumber(double value)
+{
+  std::ostringstream stream;
+  stream << value;
+  return stream.str();
+}
+
+double
+ParseDouble(const std::string & option, const std::string & text)
+{
+  const char * begin = text.c_str();
+  char *       end = nullptr;
+  errno = 0;
+  const double value = std::strtod(begin, &end);
+  if (text.empty() || end == begin || *end != '\0' || errno == ERANGE || !std::isfinite(value))
+  {
+    throw Error(option + ": '" + text + "' is not a number");
+  }
+  return value;
+}
+
+unsigned int
+ParseUnsigned(const std::string & option, const std::string & text)
+{
+  const char * begin = text.c_str();
+  char *       end = nullptr;
+  errno = 0;
+  const long long value = std::strtoll(begin, &end, 10);
+  if (text.empty() || end == begin || *end != '\0' || errno == ERANGE || value < 0 || value > 1000000000LL)
+  {
+    throw Error(option + ": '" + text + "' is not a non-negative integer");
+  }
+  return static_cast<unsigned int>(value);
+}
+
+/** Comma-separated list of exactly \a count numbers. */
+std::vector<double>
+ParseList(const std::string & option, const std::string & text, size_t count, const std::string & form)
+{
+  std::vector<double> values;
+  std::string         item;
+  std::istringstream  stream(text);
+  try
+  {
+    while (std::getline(stream, item, ','))
+    {
+      values.push_back(ParseDouble(option, item));
+    }
+  }
+  catch (const Error &)
+  {
+    throw Error(option + ": '" + text + "' is not a list of numbers " + form);
+  }
+  if (values.size() != count || (!text.empty() && text.back() == ','))
+  {
+    throw Error(option + ": expected " + std::to_string(count) + " comma-separated numbers " + form + ", got '" + text +
+                "'");
+  }
+  return values;
+}
+
+void
+RequireInRange(const std::string & option, double value, double low, double high)
+{
+  if (!(value >= low && value <= high))
+  {
+    throw Error(option + " must be in [" + FormatNumber(low) + ", " + FormatNumber(high) + "], got " +
+                FormatNumber(value));
+  }
+}
+
+void
+RequireAtLeast(const std::string & option, double value, double low)
+{
+  if (!(value >= low))
+  {
+    throw Error(option + " must be at least " + FormatNumber(low) + ", got " + FormatNumber(value));
+  }
+}
+
+/** One command-line option: its name, the name of its argument (empty for a
+ * flag), its help (meaning and units), its default, and what it sets. */
+struct Option
+{
+  std::string                              section;
+  std::string                              name;
+  std::string                              argument;
+  std::string                              help;
+  std::string                              defaultText;
+  std::function<void(const std::string &)> apply;
+};
+
+using OptionTable = std::vector<Option>;
+
+void
+AddGlobalOptions(OptionTable & table, GlobalOptions & global, const std::string & section)
+{
+  table.push_back({ section,
+                    "--threads",
+                    "N",
+                    "number of threads used by the filters",
+                    "all cores",
+                    [&global](const std::string & text) {
+                      global.threads = ParseUnsigned("--threads", text);
+                      RequireAtLeast("--threads", global.threads, 1);
+                    } });
+  table.push_back({ section,
+                    "--quiet",
+                    "",
+                    "no progress and no summary (errors are still reported on stderr)",
+                    "",
+                    [&global](const std::string &) { global.quiet = true; } });
+}
+
+OptionTable
+MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
+{
+  OptionTable       t;
+  const std::string io = "Input and output";
+  t.push_back(
+    { io,
+      "--image",
+      "PATH",
+      "3-D image to segment: any file ITK reads (.nii, .nii.gz, .nrrd, .nhdr, .mha, .mhd, ...) or a directory "
+      "holding a DICOM series; any intensity range; required",
+      "",
+      [&o](const std::string & s) { o.image = s; } });
+  t.push_back({ io,
+                "--output",
+                "MESH",
+                "deformed mesh, format chosen by extension: .vtk (legacy VTK), .obj, .off, .gii" +
+                  std::string(HasVTK() ? ", .vtp, .stl" : " (.vtp and .stl need a build with VTK)") +
+                  "; coordinates in the image's physical frame (mm); required",
+                "",
+                [&o](const std::string & s) { o.output = s; } });
+  t.push_back(
+    { io,
+      "--init-sphere",
+      "X,Y,Z,R",
+      "initial surface: a sphere of centre (X,Y,Z) and radius R in physical coordinates (mm); it must lie "
+      "inside the image",
+      "centred in the image, radius " + FormatNumber(defaults::SphereRadiusOverExtent) + " x the smallest extent",
+      [&o](const std::string & s) {
+        const auto v = ParseList("--init-sphere", s, 4, "X,Y,Z,R");
+        for (unsigned int k = 0; k < 4; ++k)
+        {
+          o.sphere[k] = v[k];
+        }
+        if (!(v[3] > 0.0))
+        {
+          throw Error("--init-sphere: the radius must be positive, got " + FormatNumber(v[3]));
+        }
+        o.hasInitSphere = true;
+      } });
+  t.push_back({ io,
+                "--sphere-resolution",
+                "N",
+                "subdivisions of the octahedron of the initial sphere (4 x 4^N + 2 points), 0 to 7",
+                std::to_string(defaults::SphereResolution),
+                [&o](const std::string & s) {
+                  o.sphereResolution = ParseUnsigned("--sphere-resolution", s);
+                  RequireInRange("--sphere-resolution", o.sphereResolution, 0, 7);
+                } });
+  t.push_back({ io,
+                "--init-mesh",
+                "MESH",
+                "initial surface: a triangle mesh (.vtk, .obj, .off, .gii, ...) in physical coordinates; instead of "
+                "--init-sphere",
+                "",
+                [&o](const std::string & s) { o.initMesh = s; } });
+  t.push_back({ io,
+                "--force-output",
+                "IMG",
+                "also write the external force field (3-component vector image, e.g. .mha, .nrrd, .nii.gz)",
+                "",
+                [&o](const std::string & s) { o.forceOutput = s; } });
+  t.push_back({ io,
+                "--snapshots",
+                "DIR",
+                "write the mesh every K iterations and a ParaView .pvd time series into DIR (needs a build with VTK)",
+                "",
+                [&o](const std::string & s) { o.snapshots = s; } });
+  t.push_back({ io,
+                "--every",
+                "K",
+                "iterations between two snapshots (with --snapshots)",
+                std::to_string(defaults::SnapshotEvery),
+                [&o](const std::string & s) {
+                  o.snapshotEvery = ParseUnsigned("--every", s);
+                  RequireAtLeast("--every", o.snapshotEvery, 1);
+                  o.snapshotEverySet = true;
+                } });
+
+  const std::string force =
+    "External force field (ExternalForceImageFilter): gradient of |gradient of the smoothed image|";
+  t.push_back({ force,
+                "--sigma",
+                "MM",
+                "standard deviation of the Gaussian smoothing, physical units (mm); sets the capture range (about 2 to "
+                "3 sigma on each side of an edge); 0 disables smoothing",
+                FormatNumber(defaults::SigmaInVoxels) + " x the smallest voxel spacing",
+                [&o](const std::string & s) {
+                  o.sigma = ParseDouble("--sigma", s);
+                  RequireAtLeast("--sigma", o.sigma, 0.0);
+                } });
+  t.push_back({ force,
+                "--no-normalize-forces",
+                "",
+                "keep the raw force field (intensity / mm^2) instead of dividing it by its largest length; --scale "
+                "is then no longer in mm (consider --max-step)",
+                "normalised",
+                [&o](const std::string &) { o.normalizeForces = false; } });
+  t.push_back({ force,
+                "--gvf",
+                "",
+                "diffuse the force by gradient vector flow (Xu and Prince): larger capture range, reaches into "
+                "concavities",
+                "off",
+                [&o](const std::string &) { o.gradientVectorFlow = true; } });
+  t.push_back({ force,
+                "--gvf-mu",
+                "MU",
+                "regularisation weight of gradient vector flow (dimensionless, > 0): larger is smoother and reaches "
+                "farther",
+                FormatNumber(defaults::GradientVectorFlowRegularization),
+                [&o](const std::string & s) {
+                  o.gradientVectorFlowRegularization = ParseDouble("--gvf-mu", s);
+                  if (!(o.gradientVectorFlowRegularization > 0.0))
+                  {
+                    throw Error("--gvf-mu must be positive, got " + FormatNumber(o.gradientVectorFlowRegularization));
+                  }
+                } });
+  t.push_back(
+    { force,
+      "--gvf-iterations",
+      "N",
+      "diffusion iterations of gradient vector flow (the field spreads as the square root of N)",
+      std::to_string(defaults::GradientVectorFlowIterations),
+      [&o](const std::string & s) { o.gradientVectorFlowIterations = ParseUnsigned("--gvf-iterations", s); } });
+
+  const std::string model = "Deformable model (DeformableMeshFilter)";
+  t.push_back({ model,
+                "--scale",
+                "MM",
+                "weight of the external force: with normalised forces, the largest external displacement per "
+                "iteration, physical units (mm)",
+                FormatNumber(defaults::ScaleOverSigma) + " x sigma",
+                [&o](const std::string & s) {
+                  o.scale = ParseDouble("--scale", s);
+                  RequireAtLeast("--scale", o.scale, 0.0);
+                } });
+  t.push_back({ model,
+                "--elasticity",
+                "A",
+                "weight of the elastic (membrane) force pulling each vertex toward the centroid of its neighbours, "
+                "dimensionless in [0, 1]",
+                FormatNumber(defaults::Elasticity),
+                [&o](const std::string & s) {
+                  o.elasticity = ParseDouble("--elasticity", s);
+                  RequireInRange("--elasticity", o.elasticity, 0.0, 1.0);
+                } });
+  t.push_back({ model,
+                "--no-tangential-elasticity",
+                "",
+                "use the full umbrella operator (Laplacian smoothing, shrinks convex surfaces) instead of its "
+                "component tangent to the surface",
+                "tangential",
+                [&o](const std::string &) { o.tangentialElasticity = false; } });
+  t.push_back({ model,
+                "--rigidity",
+                "B",
+                "weight of the rigidity (bending) force, the umbrella operator applied twice, dimensionless in [0, 1] "
+                "(elasticity + 2 x rigidity above 1 is scaled down to 1)",
+                FormatNumber(defaults::Rigidity),
+                [&o](const std::string & s) {
+                  o.rigidity = ParseDouble("--rigidity", s);
+                  RequireInRange("--rigidity", o.rigidity, 0.0, 1.0);
+                } });
+  t.push_back({ model,
+                "--balloon",
+                "MM",
+                "inflation along the outward normal per iteration, physical units (mm); negative deflates",
+                FormatNumber(defaults::Balloon),
+                [&o](const std::string & s) { o.balloon = ParseDouble("--balloon", s); } });
+  t.push_back({ model,
+                "--max-step",
+                "MM",
+                "upper bound on a vertex's displacement per iteration, physical units (mm); 0 means no bound",
+                FormatNumber(defaults::MaximumStepLength),
+                [&o](const std::string & s) {
+                  o.maximumStepLength = ParseDouble("--max-step", s);
+                  RequireAtLeast("--max-step", o.maximumStepLength, 0.0);
+                } });
+  t.push_back({ model,
+                "--iterations",
+                "N",
+                "largest number of iterations (0 writes the initial mesh)",
+                std::to_string(defaults::Iterations),
+                [&o](const std::string & s) { o.iterations = ParseUnsigned("--iterations", s); } });
+  t.push_back({ model,
+                "--tolerance",
+                "MM",
+                "stop when the largest vertex displacement stays below this length during --window iterations, "
+                "physical units (mm); 0 always runs --iterations",
+                FormatNumber(defaults::ConvergenceTolerance),
+                [&o](const std::string & s) {
+                  o.convergenceTolerance = ParseDouble("--tolerance", s);
+                  RequireAtLeast("--tolerance", o.convergenceTolerance, 0.0);
+                } });
+  t.push_back({ model,
+                "--window",
+                "N",
+                "consecutive quiet iterations that declare convergence, at least 1",
+                std::to_string(defaults::ConvergenceWindow),
+                [&o](const std::string & s) {
+                  o.convergenceWindow = ParseUnsigned("--window", s);
+                  RequireAtLeast("--window", o.convergenceWindow, 1);
+                } });
+  AddGlobalOptions(t, global, "General");
+  return t;
+}
+
+OptionTable
+MakeDemoOptions(DemoOptions & o, GlobalOptions & global)
+{
+  OptionTable t;
+  t.push_back({ "Options",
+                "--output-dir",
+                "DIR",
+                "directory for the image, the force field and the meshes (created if needed)",
+                o.outputDirectory,
+                [&o](const std::string & s) { o.outputDirectory = s; } });
+  AddGlobalOptions(t, global, "Options");
+  return t;
+}
+
+/** Greedy word wrap of \a text into lines of at most \a width characters. */
+std::vector<std::string>
+Wrap(const std::string & text, size_t width)
+{
+  std::vector<std::string> lines;
+  std::istringstream       words(text);
+  std::string              word;
+  std::string              line;
+  while (words >> word)
+  {
+    if (!line.empty() && line.size() + 1 + word.size() > width)
+    {
+      lines.push_back(line);
+      line.clear();
+    }
+    line += (line.empty() ? "" : " ") + word;
+  }
+  if (!line.empty())
+  {
+    lines.push_back(line);
+  }
+  return lines;
+}
+
+void
+PrintOptions(std::ostream & os, const OptionTable & table)
+{
+  constexpr size_t column = 30;
+  constexpr size_t width = 100;
+  std::string      section;
+  for (const auto & option : table)
+  {
+    if (option.section != section)
+    {
+      section = option.section;
+      os << "\n" << section << ":\n";
+    }
+    std::string head = "  " + option.name + (option.argument.empty() ? "" : " " + option.argument);
+    std::string text = option.help;
+    if (!option.defaultText.empty())
+    {
+      // Kept on one line: its spaces are protected from the word wrap.
+      std::string unbreakable = "[default: " + option.defaultText + "]";
+      std::replace(unbreakable.begin(), unbreakable.end(), ' ', '\x01');
+      text += " " + unbreakable;
+    }
+    auto lines = Wrap(text, width - column);
+    for (auto & line : lines)
+    {
+      std::replace(line.begin(), line.end(), '\x01', ' ');
+    }
+    if (head.size() + 2 > column)
+    {
+      os << head << "\n";
+      head.clear();
+    }
+    for (size_t i = 0; i < lines.size(); ++i)
+    {
+      const std::string left = i == 0 ? head : std::string();
+      os << left << std::string(column - left.size(), ' ') << lines[i] << "\n";
+    }
+  }
+}
+
+void
+PrintMainHelp(std::ostream & os)
+{
+  os << "Usage: edmodel [--threads N] [--quiet] COMMAND [options]\n"
+        "\n"
+        "Explicit deformable model: a surface mesh moves, iteration after iteration, under a force field\n"
+        "computed from a 3-D image and internal forces that keep it smooth, until it lies on the boundary\n"
+        "of an object. Every length is in the image's physical units (mm).\n"
+        "\n"
+        "Commands:\n"
+        "  segment    deform a sphere or a mesh onto the boundary of the object in an image\n"
+        "  demo       the seed paper's example on a generated 64^3 ellipsoid image, with its accuracy\n"
+        "\n"
+        "Options:\n"
+        "  --help, -h       this help (edmodel COMMAND --help for the options of a command)\n"
+        "  --version        version of edmodel and of the libraries it uses\n"
+        "  --threads N      number of threads used by the filters [default: all cores]\n"
+        "  --quiet          no progress and no summary\n"
+        "\n"
+        "Examples:\n"
+        "  edmodel demo --output-dir /tmp/edmodel-demo\n"
+        "  edmodel segment --image liver.nii.gz --init-sphere 12.5,-40,80,15 --output liver.vtk\n"
+        "  edmodel segment --image dicom/ --init-mesh start.obj --balloon 0.1 --output surface.off\n"
+        "\n"
+        "Exit status: 0 success, 1 poor result or internal error, 2 bad command line or input.\n";
+}
+
+void
+PrintSegmentHelp(std::ostream & os, const OptionTable & table)
+{
+  os << "Usage: edmodel segment --image IMG --output MESH [--init-sphere X,Y,Z,R | --init-mesh MESH] [options]\n"
+        "\n"
+        "Computes the external force field of IMG, deforms the initial surface under it and writes the\n"
+        "result. Lengths are in physical units (mm); coordinates in the image's physical frame (origin,\n"
+        "spacing and direction honoured). The defaults need no tuning for images of any intensity range.\n";
+  PrintOptions(os, table);
+}
+
+void
+PrintDemoHelp(std::ostream & os, const OptionTable & table)
+{
+  os << "Usage: edmodel demo [--output-dir DIR]\n"
+        "\n"
+        "The seed paper's example end to end: a 64^3 binary image of an ellipsoid of radii (18, 14, 28)\n"
+        "voxels centred at (31, 31, 31), a sphere of radius 16 at the centre deformed onto it with the\n"
+        "default segment parameters plus gradient vector flow (--gvf). Writes the image (demo-image.nii.gz), the force "
+        "field\n"
+        "(demo-force.mha), the initial and final meshes (demo-sphere.vtk, demo-mesh.vtk), and prints the\n"
+        "mean and largest distance of the final mesh to the true ellipsoid. Exits with 1 when that\n"
+        "accuracy is poor.\n";
+  PrintOptions(os, table);
+}
+
+/** Applies the options of \a table found in args[first...]; returns false when
+ * --help was asked. */
+bool
+ParseOptions(const std::vector<std::string> & args,
+             size_t                           first,
+             const OptionTable &              table,
+             const std::string &              command)
+{
+  for (size_t i = first; i < args.size(); ++i)
+  {
+    std::string arg = args[i];
+    if (arg == "--help" || arg == "-h")
+    {
+      return false;
+    }
+    std::string value;
+    bool        hasValue = false;
+    const auto  equal = arg.find('=');
+    if (arg.compare(0, 2, "--") == 0 && equal != std::string::npos)
+    {
+      value = arg.substr(equal + 1);
+      arg = arg.substr(0, equal);
+      hasValue = true;
+    }
+    const Option * option = nullptr;
+    for (const auto & candidate : table)
+    {
+      if (candidate.name == arg)
+      {
+        option = &candidate;
+      }
+    }
+    if (option == nullptr)
+    {
+      throw Error("unknown option '" + args[i] + "' (see 'edmodel " + command + " --help')");
+    }
+    if (option->argument.empty())
+    {
+      if (hasValue)
+      {
+        throw Error(arg + " takes no value");
+      }
+    }
+    else if (!hasValue)
+    {
+      if (i + 1 >= args.size())
+      {
+        throw Error(arg + " needs a value (" + option->argument + ")");
+      }
+      value = args[++i];
+    }
+    option->apply(value);
+  }
+  return true;
+}
+
+int
+Main(const std::vector<std::string> & args)
+{
+  GlobalOptions global;
+  OptionTable   globalTable;
+  AddGlobalOptions(globalTable, global, "Options");
+
+  size_t i = 1;
+  for (; i < args.size(); ++i)
+  {
+    const std::string & arg = args[i];
+    if (arg == "--help" || arg == "-h")
+    {
+      PrintMainHelp(std::cout);
+      return ExitSuccess;
+    }
+    if (arg == "--version")
+    {
+      std::cout << "edmodel " << EDM_VERSION << " (ExplicitDeformableModel; " << GetLibraryVersions() << ")\n";
+      return ExitSuccess;
+    }
+    if (arg.compare(0, 1, "-") != 0)
+    {
+      break;
+    }
+    // A global option before the command.
+    const auto equal = arg.find('=');
+    const auto name = arg.substr(0, equal);
+    if (name == "--threads" || name == "--quiet")
+    {
+      std::vector<std::string> one{ args[0], arg };
+      if (name == "--threads" && equal == std::string::npos)
+      {
+        if (i + 1 >= args.size())
+        {
+          throw Error("--threads needs a value (N)");
+        }
+        one.push_back(args[++i]);
+      }
+      ParseOptions(one, 1, globalTable, "");
+      continue;
+    }
+    throw Error("unknown option '" + arg + "' (see 'edmodel --help')");
+  }
+  if (i >= args.size())
+  {
+    PrintMainHelp(std::cerr);
+    throw Error("no command given: use 'edmodel segment' or 'edmodel demo'");
+  }
+
+  const std::string command = args[i];
+  if (command == "help")
+  {
+    PrintMainHelp(std::cout);
+    return ExitSuccess;
+  }
+  if (command == "segment")
+  {
+    SegmentOptions    options;
+    const OptionTable table = MakeSegmentOptions(options, global);
+    if (!ParseOptions(args, i + 1, table, command))
+    {
+      PrintSegmentHelp(std::cout, table);
+      return ExitSuccess;
+    }
+    if (options.image.empty())
+    {
+      throw Error("segment: --image is required (see 'edmodel segment --help')");
+    }
+    if (options.output.empty())
+    {
+      throw Error("segment: --output is required (see 'edmodel segment --help')");
+    }
+    if (options.hasInitSphere && !options.initMesh.empty())
+    {
+      throw Error("segment: give --init-sphere or --init-mesh, not both");
+    }
+    if (options.snapshotEverySet && options.snapshots.empty())
+    {
+      throw Error("segment: --every needs --snapshots DIR");
+    }
+    SetNumberOfThreads(global.threads);
+    return RunSegment(options, global);
+  }
+  if (command == "demo")
+  {
+    DemoOptions       options;
+    const OptionTable table = MakeDemoOptions(options, global);
+    if (!ParseOptions(args, i + 1, table, command))
+    {
+      PrintDemoHelp(std::cout, table);
+      return ExitSuccess;
+    }
+    SetNumberOfThreads(global.threads);
+    return RunDemo(options, global);
+  }
+  throw Error("unknown command '" + command + "' (see 'edmodel --help')");
+}
+
+} // namespace
+} // namespace edm
+
+int
+main(int argc, char * argv[])
+{
+  const std::vector<std::string> args(argv, argv + argc);
+  try
+  {
+    return edm::Main(args);
+  }
+  catch (const edm::Error & error)
+  {
+    std::cerr << "edmodel: " << error.what() << std::endl;
+    return error.GetExitCode();
+  }
+  catch (const std::exception & error)
+  {
+    std::string message = error.what();
+    for (auto & c : message)
+    {
+      c = (c == '\n' || c == '\r') ? ' ' : c;
+    }
+    std::cerr << "edmodel: internal error: " << message << std::endl;
+    return edm::ExitFailure;
+  }
+}

@@ -1,0 +1,148 @@
+/*=========================================================================
+ *
+ *  Copyright NumFOCUS
+ *
+ *  Licensed under the Apache License, Version 2.0 (the "License");
+ *  you may not use this file except in compliance with the License.
+ *  You may obtain a copy of the License at
+ *
+ *         http://www.apache.org/licenses/LICENSE-2.0.txt
+ *
+ *  Unless required by applicable law or agreed to in writing, software
+ *  distributed under the License is distributed on an "AS IS" BASIS,
+ *  WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+ *  See the License for the specific language governing permissions and
+ *  limitations under the License.
+ *
+ *=========================================================================*/
+#ifndef edmodelOptions_h
+#define edmodelOptions_h
+
+// Plain C++ (no ITK header): the options of each subcommand, their defaults
+// and the error type that carries an exit code.
+
+#include <stdexcept>
+#include <string>
+
+namespace edm
+{
+
+/** Every default of the command line, in one place. Lengths are in physical
+ * units (mm for medical images). */
+namespace defaults
+{
+/** Gaussian smoothing of the force field, in voxels of the smallest spacing
+ * (so 1 mm on the seed's 1 mm grid). */
+constexpr double SigmaInVoxels = 1.0;
+/** Largest external displacement per iteration, as a fraction of Sigma. */
+constexpr double       ScaleOverSigma = 0.5;
+constexpr double       Elasticity = 0.3;
+constexpr bool         TangentialElasticity = true;
+constexpr double       Rigidity = 0.05;
+constexpr double       Balloon = 0.0;
+constexpr double       MaximumStepLength = 0.0;
+constexpr unsigned int Iterations = 500;
+constexpr double       ConvergenceTolerance = 0.01;
+constexpr unsigned int ConvergenceWindow = 5;
+constexpr bool         NormalizeForces = true;
+constexpr bool         GradientVectorFlow = false;
+constexpr double       GradientVectorFlowRegularization = 0.2;
+constexpr unsigned int GradientVectorFlowIterations = 200;
+/** Subdivisions of the octahedron of --init-sphere (4 * 4^n + 2 points). */
+constexpr unsigned int SphereResolution = 4;
+/** Radius of the default initial sphere, as a fraction of the smallest
+ * physical extent of the image. */
+constexpr double       SphereRadiusOverExtent = 0.25;
+constexpr unsigned int SnapshotEvery = 10;
+/** The demo adds gradient vector flow to the segment defaults: the seed's
+ * sphere starts 12 voxels from the ends of the ellipsoid, beyond the capture
+ * range of the plain gradient force at sigma = 1 voxel. */
+constexpr bool DemoGradientVectorFlow = true;
+} // namespace defaults
+
+/** Exit codes. */
+constexpr int ExitSuccess = 0;
+constexpr int ExitFailure = 1; // the run completed but its result is poor, or an internal error
+constexpr int ExitUsage = 2;   // bad command line or bad input: nothing was written
+
+/** An error reported as one line on stderr, with its exit code. */
+class Error : public std::runtime_error
+{
+public:
+  explicit Error(const std::string & message, int exitCode = ExitUsage)
+    : std::runtime_error(message)
+    , m_ExitCode(exitCode)
+  {}
+  int
+  GetExitCode() const
+  {
+    return m_ExitCode;
+  }
+
+private:
+  int m_ExitCode;
+};
+
+/** Options shared by every subcommand. */
+struct GlobalOptions
+{
+  unsigned int threads{ 0 }; // 0: ITK's default
+  bool         quiet{ false };
+};
+
+struct SegmentOptions
+{
+  std::string  image;
+  std::string  output;
+  std::string  initMesh;
+  std::string  forceOutput;
+  std::string  snapshots;
+  bool         hasInitSphere{ false };
+  double       sphere[4]{ 0.0, 0.0, 0.0, 0.0 }; // centre x, y, z and radius
+  unsigned int sphereResolution{ defaults::SphereResolution };
+
+  double       sigma{ -1.0 }; // negative: defaults::SigmaInVoxels times the smallest spacing
+  double       scale{ -1.0 }; // negative: defaults::ScaleOverSigma times sigma
+  bool         normalizeForces{ defaults::NormalizeForces };
+  bool         gradientVectorFlow{ defaults::GradientVectorFlow };
+  double       gradientVectorFlowRegularization{ defaults::GradientVectorFlowRegularization };
+  unsigned int gradientVectorFlowIterations{ defaults::GradientVectorFlowIterations };
+
+  double       elasticity{ defaults::Elasticity };
+  bool         tangentialElasticity{ defaults::TangentialElasticity };
+  double       rigidity{ defaults::Rigidity };
+  double       balloon{ defaults::Balloon };
+  double       maximumStepLength{ defaults::MaximumStepLength };
+  unsigned int iterations{ defaults::Iterations };
+  double       convergenceTolerance{ defaults::ConvergenceTolerance };
+  unsigned int convergenceWindow{ defaults::ConvergenceWindow };
+  unsigned int snapshotEvery{ defaults::SnapshotEvery };
+  bool         snapshotEverySet{ false };
+};
+
+struct DemoOptions
+{
+  std::string outputDirectory{ "edmodel-demo" };
+};
+
+/** Subcommands, implemented in edmodelPipeline.cxx. They throw Error. */
+int
+RunSegment(const SegmentOptions & options, const GlobalOptions & global);
+int
+RunDemo(const DemoOptions & options, const GlobalOptions & global);
+
+/** Applies --threads to ITK's threaders (before any filter is created). */
+void
+SetNumberOfThreads(unsigned int threads);
+
+/** "ITK 5.2.1" and whether VTK outputs are available. */
+std::string
+GetLibraryVersions();
+
+/** True when mesh formats that need VTK (.vtp, .stl, .pvd) can be written. */
+bool
+HasVTK();
+
+} // namespace edm
+
+#endif

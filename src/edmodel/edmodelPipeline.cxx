@@ -1,0 +1,483 @@
+
+// The subcommands: the ITK pipeline ExternalForceImageFilter ->
+// DeformableMeshFilter, with progress reporting. No deformation maths here:
+// the filters do it.
+
+#include "edmodelIO.h"
+#include "edmodelOptions.h"
+
+#include "itkDeformableMeshFilter.h"
+#include "itkEllipsoidPhantom.h"
+#include "itkExternalForceImageFilter.h"
+#include "itkMultiThreaderBase.h"
+#include "itkVersion.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <unistd.h>
+
+namespace edm
+{
+namespace
+{
+
+using ForceFilterType = itk::ExternalForceImageFilter<ImageType, ForceImageType>;
+using DeformFilterType = itk::DeformableMeshFilter<MeshType, ForceImageType>;
+
+/** Accuracy the demo must reach, in voxels, to exit with 0. */
+constexpr double DemoMeanDistanceLimit = 0.5;
+constexpr double DemoMaximumDistanceLimit = 1.5;
+
+std::string
+Format(double value, int precision = 3)
+{
+  std::ostringstream stream;
+  stream << std::setprecision(precision) << value;
+  return stream.str();
+}
+
+std::string
+FormatPoint(const double * p, unsigned int n)
+{
+  std::string text = "(";
+  for (unsigned int k = 0; k < n; ++k)
+  {
+    text += (k == 0 ? "" : ", ") + Format(p[k], 6);
+  }
+  return text + ")";
+}
+
+/** Progress on stderr: a bar redrawn in place on a terminal, a plain line
+ * every tenth otherwise, nothing with --quiet. */
+class Progress
+{
+public:
+  explicit Progress(bool quiet)
+    : m_Enabled(!quiet)
+    , m_Terminal(isatty(fileno(stderr)) != 0)
+  {}
+
+  void
+  Start(const std::string & stage)
+  {
+    m_Stage = stage;
+    m_LastTenth = -1;
+    m_LastDraw = std::chrono::steady_clock::time_point();
+    m_Drawn = false;
+  }
+
+  void
+  Update(double fraction, const std::string & detail)
+  {
+    if (!m_Enabled)
+    {
+      return;
+    }
+    fraction = std::min(1.0, std::max(0.0, fraction));
+    if (m_Terminal)
+    {
+      const auto now = std::chrono::steady_clock::now();
+      if (fraction < 1.0 && m_Drawn && now - m_LastDraw < std::chrono::milliseconds(100))
+      {
+        return;
+      }
+      m_LastDraw = now;
+      m_Drawn = true;
+      constexpr int width = 30;
+      const int     filled = static_cast<int>(fraction * width + 0.5);
+      std::cerr << "\r\033[K" << m_Stage << " [" << std::string(filled, '#') << std::string(width - filled, '.') << "] "
+                << std::setw(3) << static_cast<int>(fraction * 100.0 + 0.5) << "%  " << detail << std::flush;
+      return;
+    }
+    const int tenth = static_cast<int>(fraction * 10.0 + 1e-9);
+    if (tenth > m_LastTenth)
+    {
+      m_LastTenth = tenth;
+      std::cerr << "edmodel: " << m_Stage << " " << std::setw(3) << tenth * 10 << "%" << (detail.empty() ? "" : "  ")
+                << detail << std::endl;
+    }
+  }
+
+  /** Ends the stage with a summary line. */
+  void
+  Finish(const std::string & summary)
+  {
+    if (!m_Enabled)
+    {
+      return;
+    }
+    if (m_Terminal && m_Drawn)
+    {
+      std::cerr << "\r\033[K";
+    }
+    std::cerr << "edmodel: " << m_Stage << ": " << summary << std::endl;
+  }
+
+  void
+  Note(const std::string & text)
+  {
+    if (m_Enabled)
+    {
+      std::cerr << "edmodel: " << text << std::endl;
+    }
+  }
+
+private:
+  bool                                  m_Enabled;
+  bool                                  m_Terminal;
+  std::string                           m_Stage;
+  int                                   m_LastTenth{ -1 };
+  bool                                  m_Drawn{ false };
+  std::chrono::steady_clock::time_point m_LastDraw;
+};
+
+double
+SmallestSpacing(const ImageType * image)
+{
+  const auto & spacing = image->GetSpacing();
+  return std::min({ spacing[0], spacing[1], spacing[2] });
+}
+
+/** True when p falls within the image's voxels (half a voxel beyond the first
+ * and last voxel centres, the domain where the force is sampled). */
+bool
+IsInsideImage(const ImageType * image, const MeshType::PointType & p)
+{
+  itk::ContinuousIndex<double, 3> index;
+  image->TransformPhysicalPointToContinuousIndex(p, index);
+  const auto & region = image->GetLargestPossibleRegion();
+  for (unsigned int k = 0; k < 3; ++k)
+  {
+    const double low = static_cast<double>(region.GetIndex()[k]) - 0.5;
+    if (!(index[k] >= low && index[k] <= low + static_cast<double>(region.GetSize()[k])))
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+/** The physical bounding box of the image's voxels, for messages. */
+std::string
+DescribeBounds(const ImageType * image)
+{
+  double     low[3] = { 1e300, 1e300, 1e300 };
+  double     high[3] = { -1e300, -1e300, -1e300 };
+  const auto region = image->GetLargestPossibleRegion();
+  for (unsigned int corner = 0; corner < 8; ++corner)
+  {
+    itk::ContinuousIndex<double, 3> index;
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      index[k] = region.GetIndex()[k] - 0.5 + ((corner >> k) & 1 ? region.GetSize()[k] : 0);
+    }
+    MeshType::PointType p;
+    image->TransformContinuousIndexToPhysicalPoint(index, p);
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      low[k] = std::min(low[k], p[k]);
+      high[k] = std::max(high[k], p[k]);
+    }
+  }
+  return "x " + Format(low[0], 6) + " to " + Format(high[0], 6) + ", y " + Format(low[1], 6) + " to " +
+         Format(high[1], 6) + ", z " + Format(low[2], 6) + " to " + Format(high[2], 6) + " mm";
+}
+
+MeshType::Pointer
+MakeInitialSphere(const ImageType * image, const SegmentOptions & options)
+{
+  MeshType::PointType center;
+  double              radius = 0.0;
+  if (options.hasInitSphere)
+  {
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      center[k] = options.sphere[k];
+    }
+    radius = options.sphere[3];
+    if (!IsInsideImage(image, center))
+    {
+      throw Error("--init-sphere: the centre " + FormatPoint(options.sphere, 3) + " is outside the image (" +
+                  DescribeBounds(image) + ")");
+    }
+  }
+  else
+  {
+    const auto &                    region = image->GetLargestPossibleRegion();
+    itk::ContinuousIndex<double, 3> middle;
+    double                          smallestExtent = 1e300;
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      middle[k] = region.GetIndex()[k] + 0.5 * (static_cast<double>(region.GetSize()[k]) - 1.0);
+      smallestExtent = std::min(smallestExtent, region.GetSize()[k] * image->GetSpacing()[k]);
+    }
+    image->TransformContinuousIndexToPhysicalPoint(middle, center);
+    radius = defaults::SphereRadiusOverExtent * smallestExtent;
+  }
+  MeshType::Pointer sphere = itk::MakeSphereMesh<MeshType>(center, radius, options.sphereResolution);
+  for (auto it = sphere->GetPoints()->Begin(); it != sphere->GetPoints()->End(); ++it)
+  {
+    if (!IsInsideImage(image, it.Value()))
+    {
+      const double c[3] = { center[0], center[1], center[2] };
+      throw Error("--init-sphere: the sphere of centre " + FormatPoint(c, 3) + " and radius " + Format(radius, 6) +
+                  " mm extends outside the image (" + DescribeBounds(image) + ")");
+    }
+  }
+  return sphere;
+}
+
+void
+CheckInitialMesh(const ImageType * image, const MeshType * mesh, const std::string & path, Progress & progress)
+{
+  size_t outside = 0;
+  for (auto it = mesh->GetPoints()->Begin(); it != mesh->GetPoints()->End(); ++it)
+  {
+    outside += IsInsideImage(image, it.Value()) ? 0 : 1;
+  }
+  if (outside == mesh->GetNumberOfPoints())
+  {
+    throw Error("--init-mesh: mesh '" + path + "' lies outside the image (" + DescribeBounds(image) + ")");
+  }
+  if (outside > 0)
+  {
+    progress.Note("warning: " + std::to_string(outside) + " of " + std::to_string(mesh->GetNumberOfPoints()) +
+                  " points of the initial mesh are outside the image and feel no external force");
+  }
+}
+
+struct DeformResult
+{
+  MeshType::Pointer       mesh;
+  ForceImageType::Pointer force;
+  double                  sigma{ 0.0 };
+  double                  scale{ 0.0 };
+  itk::SizeValueType      iterations{ 0 };
+  bool                    converged{ false };
+  double                  lastMaximumDisplacement{ 0.0 };
+};
+
+/** The force field and the deformation, by the ITK filters. */
+DeformResult
+Deform(const ImageType * image, const MeshType * initial, const SegmentOptions & o, Progress & progress)
+{
+  DeformResult result;
+  result.sigma = o.sigma >= 0.0 ? o.sigma : defaults::SigmaInVoxels * SmallestSpacing(image);
+  const double scaleBase = result.sigma > 0.0 ? result.sigma : SmallestSpacing(image);
+  result.scale = o.scale >= 0.0 ? o.scale : defaults::ScaleOverSigma * scaleBase;
+
+  auto force = ForceFilterType::New();
+  force->SetInput(image);
+  force->SetSigma(result.sigma);
+  force->SetNormalizeForces(o.normalizeForces);
+  force->SetUseGradientVectorFlow(o.gradientVectorFlow);
+  force->SetGradientVectorFlowRegularization(o.gradientVectorFlowRegularization);
+  force->SetGradientVectorFlowIterations(o.gradientVectorFlowIterations);
+  progress.Start("force field");
+  force->AddObserver(itk::ProgressEvent(),
+                     [&](const itk::EventObject &) { progress.Update(force->GetProgress(), ""); });
+  const auto start = std::chrono::steady_clock::now();
+  force->Update();
+  result.force = force->GetOutput();
+  const auto seconds = [&start]() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  progress.Finish("sigma " + Format(result.sigma) + " mm" + (o.gradientVectorFlow ? ", gradient vector flow" : "") +
+                  (o.normalizeForces ? ", normalised" : ", not normalised") + " (" + Format(seconds(), 2) + " s)");
+
+  auto deform = DeformFilterType::New();
+  deform->SetInput(initial);
+  deform->SetForceImage(result.force);
+  deform->SetScaleFactor(result.scale);
+  deform->SetElasticity(o.elasticity);
+  deform->SetTangentialElasticity(o.tangentialElasticity);
+  deform->SetRigidity(o.rigidity);
+  deform->SetBalloon(o.balloon);
+  deform->SetMaximumStepLength(o.maximumStepLength);
+  deform->SetConvergenceTolerance(o.convergenceTolerance);
+  deform->SetConvergenceWindow(o.convergenceWindow);
+  deform->SetNumberOfIterations(o.iterations);
+  progress.Start("deforming");
+  const auto deformStart = std::chrono::steady_clock::now();
+  deform->AddObserver(itk::ProgressEvent(), [&](const itk::EventObject &) {
+    const auto total = deform->GetNumberOfIterations();
+    const auto current = deform->GetCurrentIteration();
+    progress.Update(total > 0 ? static_cast<double>(current) / total : 1.0,
+                    "iteration " + std::to_string(current) + "/" + std::to_string(total) + ", largest step " +
+                      Format(deform->GetLastMaximumDisplacement()) + " mm");
+  });
+  deform->Update();
+  result.mesh = deform->GetOutput();
+  result.mesh->DisconnectPipeline();
+  result.iterations = deform->GetCurrentIteration();
+  result.converged = deform->GetConverged();
+  result.lastMaximumDisplacement = deform->GetLastMaximumDisplacement();
+  const double deformSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - deformStart).count();
+  progress.Finish(std::to_string(result.iterations) + " iterations, " +
+                  (result.converged ? "converged (largest step below " + Format(o.convergenceTolerance) + " mm for " +
+                                        std::to_string(o.convergenceWindow) + " iterations)"
+                                    : std::string("iteration cap reached")) +
+                  ", last largest step " + Format(result.lastMaximumDisplacement) + " mm (" + Format(deformSeconds, 2) +
+                  " s)");
+  return result;
+}
+
+} // namespace
+
+void
+SetNumberOfThreads(unsigned int threads)
+{
+  if (threads > 0)
+  {
+    itk::MultiThreaderBase::SetGlobalDefaultNumberOfThreads(threads);
+  }
+}
+
+bool
+HasVTK()
+{
+#ifdef EDM_HAVE_VTK
+  return true;
+#else
+  return false;
+#endif
+}
+
+std::string
+GetLibraryVersions()
+{
+  return "ITK " + std::string(itk::Version::GetITKVersion()) + (HasVTK() ? ", with VTK" : ", without VTK");
+}
+
+int
+RunSegment(const SegmentOptions & o, const GlobalOptions & global)
+{
+  // Every output is checked before the long computation starts.
+  CheckMeshOutputPath(o.output, "--output");
+  if (!o.forceOutput.empty())
+  {
+    CheckImageOutputPath(o.forceOutput, "--force-output");
+  }
+  if (!o.snapshots.empty() && !HasVTK())
+  {
+    throw Error("--snapshots: the .pvd time series needs VTK, and this edmodel was built without VTK");
+  }
+
+  Progress           progress(global.quiet);
+  ImageType::Pointer image = ReadImage(o.image);
+  MeshType::Pointer  initial;
+  if (!o.initMesh.empty())
+  {
+    initial = ReadMesh(o.initMesh, "--init-mesh");
+    CheckInitialMesh(image, initial, o.initMesh, progress);
+  }
+  else
+  {
+    initial = MakeInitialSphere(image, o);
+  }
+  const auto size = image->GetLargestPossibleRegion().GetSize();
+  progress.Note("image " + std::to_string(size[0]) + " x " + std::to_string(size[1]) + " x " + std::to_string(size[2]) +
+                ", spacing " + Format(image->GetSpacing()[0]) + " x " + Format(image->GetSpacing()[1]) + " x " +
+                Format(image->GetSpacing()[2]) + " mm; initial mesh " + std::to_string(initial->GetNumberOfPoints()) +
+                " points");
+
+  const DeformResult result = Deform(image, initial, o, progress);
+
+  if (!o.forceOutput.empty())
+  {
+    WriteImage(result.force, o.forceOutput);
+  }
+  WriteMesh(result.mesh, o.output);
+  if (!global.quiet)
+  {
+    std::cout << "edmodel: wrote " << o.output << " (" << result.mesh->GetNumberOfPoints() << " points, "
+              << CountSurfaceCells(result.mesh) << " faces) after " << result.iterations << " iterations"
+              << (result.converged ? ", converged" : ", not converged") << std::endl;
+  }
+  return ExitSuccess;
+}
+
+int
+RunDemo(const DemoOptions & options, const GlobalOptions & global)
+{
+  namespace fs = std::filesystem;
+  std::error_code error;
+  fs::create_directories(options.outputDirectory, error);
+  if (!fs::is_directory(options.outputDirectory))
+  {
+    throw Error("--output-dir: cannot create directory '" + options.outputDirectory + "'" +
+                (error ? ": " + error.message() : std::string()));
+  }
+  const fs::path directory(options.outputDirectory);
+  const auto     imagePath = (directory / "demo-image.nii.gz").string();
+  const auto     forcePath = (directory / "demo-force.mha").string();
+  const auto     spherePath = (directory / "demo-sphere.vtk").string();
+  const auto     meshPath = (directory / "demo-mesh.vtk").string();
+
+  // The seed's example: a 64^3 binary ellipsoid and a sphere at its centre.
+  const double                      centerValues[3] = { 31.0, 31.0, 31.0 };
+  const double                      radiiValues[3] = { 18.0, 14.0, 28.0 };
+  constexpr double                  sphereRadius = 16.0;
+  itk::EllipsoidPhantom::PointType  center(centerValues);
+  itk::EllipsoidPhantom::VectorType radii(radiiValues);
+  const itk::EllipsoidPhantom       phantom(center, radii);
+
+  ImageType::SizeType size;
+  size.Fill(64);
+  ImageType::SpacingType   spacing(1.0);
+  ImageType::PointType     origin(0.0);
+  ImageType::DirectionType direction;
+  direction.SetIdentity();
+  ImageType::Pointer image = phantom.MakeImage<ImageType>(size, spacing, origin, direction, 1.0f, 0.0f);
+
+  SegmentOptions segment; // the defaults of 'edmodel segment'
+  segment.gradientVectorFlow = defaults::DemoGradientVectorFlow;
+  segment.hasInitSphere = true;
+  for (unsigned int k = 0; k < 3; ++k)
+  {
+    segment.sphere[k] = centerValues[k];
+  }
+  segment.sphere[3] = sphereRadius;
+  MeshType::Pointer sphere = MakeInitialSphere(image, segment);
+
+  Progress progress(global.quiet);
+  progress.Note("demo: 64^3 binary ellipsoid of radii (18, 14, 28) voxels centred at (31, 31, 31); sphere of radius " +
+                Format(sphereRadius) + " at the centre, " + std::to_string(sphere->GetNumberOfPoints()) + " points");
+  const DeformResult result = Deform(image, sphere, segment, progress);
+
+  WriteImage(image, imagePath);
+  WriteImage(result.force, forcePath);
+  WriteMesh(sphere, spherePath);
+  WriteMesh(result.mesh, meshPath);
+
+  double mean = 0.0;
+  double maximum = 0.0;
+  phantom.MeasureDistance(result.mesh.GetPointer(), mean, maximum);
+  double initialMean = 0.0;
+  double initialMaximum = 0.0;
+  phantom.MeasureDistance(sphere.GetPointer(), initialMean, initialMaximum);
+  const bool good = mean < DemoMeanDistanceLimit && maximum < DemoMaximumDistanceLimit;
+
+  // The result goes to stdout even with --quiet: it is what the demo is for.
+  std::cout << "edmodel demo: sphere -> ellipsoid in " << result.iterations << " iterations"
+            << (result.converged ? " (converged)" : " (iteration cap)") << "\n"
+            << "  distance to the true ellipsoid, initial sphere: mean " << Format(initialMean) << " voxel, max "
+            << Format(initialMaximum) << " voxel\n"
+            << "  distance to the true ellipsoid, final mesh:     mean " << Format(mean) << " voxel, max "
+            << Format(maximum) << " voxel\n"
+            << "  accuracy " << (good ? "good" : "POOR") << " (limits: mean < " << DemoMeanDistanceLimit
+            << " voxel, max < " << DemoMaximumDistanceLimit << " voxel)\n"
+            << "  wrote " << imagePath << ", " << forcePath << ", " << spherePath << ", " << meshPath << "\n"
+            << "  same run by hand: edmodel segment --image " << imagePath << " --init-sphere 31,31,31,16"
+            << (segment.gradientVectorFlow ? " --gvf" : "") << " --output " << (directory / "mesh.vtk").string()
+            << "\n";
+  return good ? ExitSuccess : ExitFailure;
+}
+
+} // namespace edm

@@ -1,0 +1,53 @@
+# edmodel --help, segment --help, demo --help, --version: exit code 0 and the
+# documentation of every option (units and defaults).
+cmake_minimum_required(VERSION 3.16)
+function(edm_help variable)
+  execute_process(COMMAND ${EDMODEL} ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT err STREQUAL "")
+    message(FATAL_ERROR "edmodel ${ARGN}: exit code ${rc}, stderr '${err}'")
+  endif()
+  set(${variable} "${out}" PARENT_SCOPE)
+endfunction()
+edm_help(main_help --help)
+edm_help(segment_help segment --help)
+edm_help(demo_help demo --help)
+edm_help(version --version)
+
+if(NOT "${version}" MATCHES "^edmodel [0-9]+\\.[0-9]+\\.[0-9]+ .*ITK 5")
+  message(FATAL_ERROR "--version: '${version}'")
+endif()
+foreach(word segment demo --threads --quiet --version)
+  if(NOT "${main_help}" MATCHES "${word}")
+    message(FATAL_ERROR "--help does not mention ${word}")
+  endif()
+endforeach()
+if(NOT "${demo_help}" MATCHES "--output-dir DIR")
+  message(FATAL_ERROR "demo --help does not document --output-dir")
+endif()
+
+# The entry of an option: its first line and the continuation lines.
+function(edm_entry variable option)
+  string(REGEX MATCH "\n  ${option}[ \n][^\n]*(\n                              [^\n]*)*" entry "${segment_help}")
+  set(${variable} "${entry}" PARENT_SCOPE)
+endfunction()
+# Options with a length: documented in mm.
+foreach(option --sigma --scale --balloon --max-step --tolerance --init-sphere)
+  edm_entry(entry ${option})
+  if(NOT entry MATCHES "\\(mm\\)")
+    message(FATAL_ERROR "segment --help: ${option} without its unit:${entry}")
+  endif()
+endforeach()
+# Options with a value: documented with their default.
+foreach(option --sigma --scale --elasticity --rigidity --balloon --max-step --iterations --tolerance --window
+    --gvf-mu --gvf-iterations --sphere-resolution --every --threads --init-sphere)
+  edm_entry(entry ${option})
+  if(NOT entry MATCHES "\\[default: [^]]+\\]")
+    message(FATAL_ERROR "segment --help: ${option} without its default:${entry}")
+  endif()
+endforeach()
+foreach(option --image --output --init-mesh --force-output --snapshots --no-normalize-forces --gvf
+    --no-tangential-elasticity --quiet)
+  if(NOT segment_help MATCHES "  ${option}[ \n]")
+    message(FATAL_ERROR "segment --help does not document ${option}")
+  endif()
+endforeach()

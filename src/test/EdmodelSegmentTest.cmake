@@ -1,0 +1,43 @@
+# End-to-end run of 'edmodel segment' on a generated ellipsoid image; the
+# output mesh is read back and measured against the exact ellipsoid.
+#
+# EDMODEL, TOOL, WORK: the programs and the test's directory.
+# PHANTOM: edmodelTestTool arguments that write the image (phantom or dicom).
+# SETUP: optional extra helper command (edmodelTestTool arguments).
+# SEGMENT: edmodel arguments.
+# OUTPUT: the mesh edmodel writes, measured with MEASURE (edmodelTestTool
+# measure arguments after the path).
+cmake_minimum_required(VERSION 3.16)
+include(${CMAKE_CURRENT_LIST_DIR}/EdmodelTestCommon.cmake)
+
+edm_fresh_work()
+edm_run_helper("${TOOL}|${PHANTOM}")
+if(SETUP)
+  edm_run_helper("${TOOL}|${SETUP}")
+endif()
+
+edm_expand(arguments "${SEGMENT}")
+edm_expand(output "${OUTPUT}")
+execute_process(COMMAND ${EDMODEL} ${arguments} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message(STATUS "edmodel ${arguments}\n${err}${out}")
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "edmodel exited with ${rc}")
+endif()
+if("--quiet" IN_LIST arguments)
+  if(NOT err STREQUAL "" OR NOT out STREQUAL "")
+    message(FATAL_ERROR "--quiet, yet edmodel printed something")
+  endif()
+elseif(NOT err MATCHES "edmodel: deforming: [0-9]+ iterations" OR NOT out MATCHES "^edmodel: wrote ")
+  message(FATAL_ERROR "no progress on stderr or no summary on stdout")
+endif()
+if(NOT EXISTS "${output}")
+  message(FATAL_ERROR "no output mesh ${output}")
+endif()
+edm_check_no_leftovers()
+
+edm_expand(measure "${MEASURE}")
+execute_process(COMMAND ${TOOL} measure ${output} ${measure} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message(STATUS "${out}${err}")
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "the output mesh is not on the ellipsoid")
+endif()
