@@ -81,8 +81,10 @@
  * vectors, else the first array whose number of components fits the pixel.
  * Values are converted to the pixel's component type.
  *
- * Coordinates: VTK points of the ITK coordinate type (double for
- * itk::Mesh<double, 3>); values are copied exactly. Meshes of dimension 2 get
+ * Coordinates: VTK points of the ITK coordinate type, the traits'
+ * CoordRepType: float for itk::Mesh<double, 3> (ITK's default traits), double
+ * for edm::PolyDataMeshType. Values are copied exactly when the ITK type holds
+ * them (float VTK points always; double VTK points with PolyDataMeshType). Meshes of dimension 2 get
  * z = 0 in VTK and drop z coming back.
  *
  * Errors (a cell that refers to a missing point, an array whose number of
@@ -92,6 +94,11 @@
  */
 namespace edm
 {
+
+/** An itk::Mesh with double coordinates (itk::Mesh<double, 3> has float ones:
+ * its traits' CoordRepType is float). It holds a vtkPolyData of double points
+ * exactly; the VTK algorithms of this module compute with it. */
+using PolyDataMeshType = itk::Mesh<double, 3, itk::DefaultStaticMeshTraits<double, 3, 3, double, double, double>>;
 
 /** Options of the mesh conversions. */
 struct MeshBridgeOptions

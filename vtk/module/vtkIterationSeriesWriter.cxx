@@ -17,6 +17,7 @@
  *=========================================================================*/
 #include "vtkIterationSeriesWriter.h"
 
+#include "vtkErrorCode.h"
 #include "vtkIterativePolyDataAlgorithm.h"
 #include "vtkObjectFactory.h"
 #include "vtkPolyData.h"
@@ -164,7 +165,7 @@ vtkIterationSeriesWriter::WriteIteration(vtkPolyData * mesh, int iteration)
   {
     writer->SetDataModeToAscii();
   }
-  if (writer->Write() != 1)
+  if (writer->Write() != 1 || writer->GetErrorCode() != vtkErrorCode::NoError)
   {
     vtkErrorMacro("Cannot write " << path << ".");
     return 0;

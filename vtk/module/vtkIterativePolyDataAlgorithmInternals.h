@@ -18,8 +18,8 @@
 #ifndef vtkIterativePolyDataAlgorithmInternals_h
 #define vtkIterativePolyDataAlgorithmInternals_h
 
+#include "edmMeshBridge.h"
 #include "itkIterativeMeshFilter.h"
-#include "itkMesh.h"
 
 #include "vtkType.h"
 
@@ -34,7 +34,7 @@ class vtkPolyData;
 class vtkIterativePolyDataAlgorithmInternals
 {
 public:
-  using MeshType = itk::Mesh<double, 3>;
+  using MeshType = edm::PolyDataMeshType; // double coordinates
   using FilterType = itk::IterativeMeshFilter<MeshType, MeshType>;
 
   FilterType::Pointer Filter;
