@@ -38,3 +38,10 @@ set_property(CACHE EDM_USE_VTK PROPERTY STRINGS AUTO ON OFF)
 if(NOT EDM_USE_VTK STREQUAL "OFF")
   add_subdirectory(vtk)
 endif()
+
+# Benchmarks (bench/, Google Benchmark): on by default when benchmark is found.
+find_package(benchmark QUIET)
+option(EDM_BUILD_BENCHMARKS "Build the benchmarks (bench/, needs Google Benchmark)" ${benchmark_FOUND})
+if(EDM_BUILD_BENCHMARKS)
+  add_subdirectory(bench)
+endif()

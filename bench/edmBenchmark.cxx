@@ -1,0 +1,866 @@
+/*=========================================================================
+ *
+ *  Copyright NumFOCUS
+ *
+ *  Licensed under the Apache License, Version 2.0 (the "License");
+ *  you may not use this file except in compliance with the License.
+ *  You may obtain a copy of the License at
+ *
+ *         http://www.apache.org/licenses/LICENSE-2.0.txt
+ *
+ *  Unless required by applicable law or agreed to in writing, software
+ *  distributed under the License is distributed on an "AS IS" BASIS,
+ *  WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+ *  See the License for the specific language governing permissions and
+ *  limitations under the License.
+ *
+ *=========================================================================*/
+
+// Throughput of the explicit deformable model against its anchors, on the
+// seed's ellipsoid phantom (scaled to 128^3 voxels) and geodesic spheres of
+// about 10k, 100k and 1M vertices:
+//   EDM/DeformableMesh          our DeformableMeshFilter, external forces +
+//                               Elasticity + Rigidity, 1 and 2 threads;
+//   ITK/DeformableSimplexMesh3D ITK's simplex-mesh model (serial), on the
+//                               simplex mesh dual to a triangle mesh with about
+//                               as many triangles as the others have vertices;
+//   VTK/ProbeWarp               the seed's VTK loop, vtkProbeFilter then
+//                               vtkWarpVector (external force only), when VTK
+//                               is found;
+//   EDM/ExternalForce           the force-field filter on 128^3 and 256^3;
+//   ITK/GradientTwice           two ITK GradientImageFilter passes, the least
+//                               work that grad |grad I| needs;
+//   EDM/StateMemory             bytes per vertex of the filter's iteration
+//                               state (must stay under 200).
+// A summary of the ratios follows the benchmark table; the exit code is
+// non-zero when the memory check fails.
+
+#include "itkDeformableMeshFilter.h"
+#include "itkEllipsoidPhantom.h"
+#include "itkExternalForceImageFilter.h"
+
+#include "itkDefaultDynamicMeshTraits.h"
+#include "itkDeformableSimplexMesh3DFilter.h"
+#include "itkGradientImageFilter.h"
+#include "itkMesh.h"
+#include "itkMultiThreaderBase.h"
+#include "itkSimplexMesh.h"
+#include "itkTriangleCell.h"
+#include "itkTriangleMeshToSimplexMeshFilter.h"
+
+#ifdef EDM_BENCHMARK_WITH_VTK
+#  include "vtkCellArray.h"
+#  include "vtkFloatArray.h"
+#  include "vtkImageData.h"
+#  include "vtkNew.h"
+#  include "vtkPointData.h"
+#  include "vtkPoints.h"
+#  include "vtkPolyData.h"
+#  include "vtkProbeFilter.h"
+#  include "vtkSMPTools.h"
+#  include "vtkSmartPointer.h"
+#  include "vtkWarpVector.h"
+#endif
+
+#include <benchmark/benchmark.h>
+
+#include <malloc.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <new>
+#include <string>
+#include <vector>
+
+// Live and peak heap bytes, counted by the global allocation functions below:
+// the memory check reads the iteration state exactly instead of guessing it
+// from the resident set size.
+namespace
+{
+std::atomic<int64_t> liveHeapBytes{ 0 };
+std::atomic<int64_t> peakHeapBytes{ 0 };
+
+void *
+CountedAllocate(std::size_t size)
+{
+  void * p = std::malloc(size == 0 ? 1 : size);
+  if (p == nullptr)
+  {
+    throw std::bad_alloc();
+  }
+  const int64_t live = liveHeapBytes.fetch_add(static_cast<int64_t>(malloc_usable_size(p)), std::memory_order_relaxed) +
+                       static_cast<int64_t>(malloc_usable_size(p));
+  int64_t peak = peakHeapBytes.load(std::memory_order_relaxed);
+  while (live > peak && !peakHeapBytes.compare_exchange_weak(peak, live, std::memory_order_relaxed))
+  {}
+  return p;
+}
+
+void
+CountedFree(void * p) noexcept
+{
+  if (p != nullptr)
+  {
+    liveHeapBytes.fetch_sub(static_cast<int64_t>(malloc_usable_size(p)), std::memory_order_relaxed);
+    std::free(p);
+  }
+}
+} // namespace
+
+void *
+operator new(std::size_t size)
+{
+  return CountedAllocate(size);
+}
+void *
+operator new[](std::size_t size)
+{
+  return CountedAllocate(size);
+}
+void
+operator delete(void * p) noexcept
+{
+  CountedFree(p);
+}
+void
+operator delete[](void * p) noexcept
+{
+  CountedFree(p);
+}
+void
+operator delete(void * p, std::size_t) noexcept
+{
+  CountedFree(p);
+}
+void
+operator delete[](void * p, std::size_t) noexcept
+{
+  CountedFree(p);
+}
+
+namespace
+{
+constexpr unsigned int Dimension = 3;
+using ImageType = itk::Image<float, Dimension>;
+using ForceImageType = itk::Image<itk::CovariantVector<float, Dimension>, Dimension>;
+using MeshType = itk::Mesh<float, Dimension>;
+using ModelType = itk::DeformableMeshFilter<MeshType, ForceImageType>;
+using ForceFilterType = itk::ExternalForceImageFilter<ImageType, ForceImageType>;
+
+using SimplexTraits = itk::DefaultDynamicMeshTraits<double, 3, 3, double, double>;
+using TriangleMeshType = itk::Mesh<double, Dimension, SimplexTraits>;
+using SimplexMeshType = itk::SimplexMesh<double, Dimension, SimplexTraits>;
+using SimplexModelType = itk::DeformableSimplexMesh3DFilter<SimplexMeshType, SimplexMeshType>;
+
+// The seed's case (64^3 voxels, ellipsoid of radii (18, 14, 18) centred at
+// voxel 31, initial sphere of radius 16), scaled by 2; unit spacing and zero
+// origin, which DeformableSimplexMesh3DFilter requires.
+constexpr unsigned int MeshImageSize = 128;
+constexpr double       PhantomScale = MeshImageSize / 64.0;
+
+itk::EllipsoidPhantom
+MakePhantom(double scale)
+{
+  itk::EllipsoidPhantom::PointType center;
+  center.Fill(31.0 * scale);
+  itk::EllipsoidPhantom::VectorType radii;
+  radii[0] = 18.0 * scale;
+  radii[1] = 14.0 * scale;
+  radii[2] = 18.0 * scale;
+  return itk::EllipsoidPhantom(center, radii);
+}
+
+ImageType::Pointer
+MakePhantomImage(unsigned int size)
+{
+  ImageType::SizeType imageSize;
+  imageSize.Fill(size);
+  ImageType::SpacingType spacing;
+  spacing.Fill(1.0);
+  ImageType::PointType origin;
+  origin.Fill(0.0);
+  ImageType::DirectionType direction;
+  direction.SetIdentity();
+  return MakePhantom(size / 64.0).MakeImage<ImageType>(imageSize, spacing, origin, direction, 100.0f, 0.0f);
+}
+
+/** Force field of the mesh benchmarks, computed once. */
+const ForceImageType *
+MeshForceImage()
+{
+  static ForceImageType::Pointer field = [] {
+    auto forces = ForceFilterType::New();
+    forces->SetInput(MakePhantomImage(MeshImageSize));
+    forces->SetSigma(1.0);
+    forces->Update();
+    ForceImageType::Pointer output = forces->GetOutput();
+    output->DisconnectPipeline();
+    return output;
+  }();
+  return field;
+}
+
+/** Geodesic sphere: the octahedron |i| + |j| + |k| = n on the integer lattice,
+ * each face cut into n^2 triangles, projected on the sphere; 4 n^2 + 2
+ * vertices, 8 n^2 triangles, outward orientation, vertices numbered face by
+ * face so that neighbours are mostly close in memory. */
+struct SphereGeometry
+{
+  std::vector<double>   points;    // x, y, z
+  std::vector<uint32_t> triangles; // a, b, c
+};
+
+SphereGeometry
+MakeGeodesicSphere(unsigned int n, double radius, double centre)
+{
+  const int64_t         side = 2 * static_cast<int64_t>(n) + 1;
+  std::vector<uint32_t> ids(static_cast<std::size_t>(side * side * 2), UINT32_MAX);
+  SphereGeometry        sphere;
+  auto                  vertex = [&](int64_t i, int64_t j, int64_t k) {
+    const std::size_t key = static_cast<std::size_t>(((i + n) * side + (j + n)) * 2 + (k < 0 ? 1 : 0));
+    if (ids[key] == UINT32_MAX)
+    {
+      ids[key] = static_cast<uint32_t>(sphere.points.size() / 3);
+      const double length = std::sqrt(static_cast<double>(i * i + j * j + k * k));
+      sphere.points.push_back(centre + radius * static_cast<double>(i) / length);
+      sphere.points.push_back(centre + radius * static_cast<double>(j) / length);
+      sphere.points.push_back(centre + radius * static_cast<double>(k) / length);
+    }
+    return ids[key];
+  };
+  const int64_t m = n;
+  for (int sz = -1; sz <= 1; sz += 2)
+  {
+    for (int sy = -1; sy <= 1; sy += 2)
+    {
+      for (int sx = -1; sx <= 1; sx += 2)
+      {
+        const bool flip = sx * sy * sz < 0; // a reflection reverses the orientation
+        auto       add = [&](int64_t a0, int64_t b0, int64_t a1, int64_t b1, int64_t a2, int64_t b2) {
+          const uint32_t p = vertex(sx * a0, sy * b0, sz * (m - a0 - b0));
+          const uint32_t q = vertex(sx * a1, sy * b1, sz * (m - a1 - b1));
+          const uint32_t r = vertex(sx * a2, sy * b2, sz * (m - a2 - b2));
+          sphere.triangles.insert(sphere.triangles.end(), { p, flip ? r : q, flip ? q : r });
+        };
+        for (int64_t a = 0; a < m; ++a)
+        {
+          for (int64_t b = 0; a + b < m; ++b)
+          {
+            add(a, b, a + 1, b, a, b + 1);
+            if (a + b + 2 <= m)
+            {
+              add(a + 1, b, a + 1, b + 1, a, b + 1);
+            }
+          }
+        }
+      }
+    }
+  }
+  return sphere;
+}
+
+/** Lattice size n of the geodesic sphere with about \a vertices vertices. */
+unsigned int
+SphereFrequency(int64_t vertices)
+{
+  return static_cast<unsigned int>(std::lround(std::sqrt((vertices - 2) / 4.0)));
+}
+
+template <typename TMesh>
+typename TMesh::Pointer
+ToITKMesh(const SphereGeometry & sphere)
+{
+  auto              mesh = TMesh::New();
+  const std::size_t numberOfPoints = sphere.points.size() / 3;
+  auto              points = TMesh::PointsContainer::New();
+  points->Reserve(numberOfPoints);
+  for (std::size_t i = 0; i < numberOfPoints; ++i)
+  {
+    typename TMesh::PointType & p = points->ElementAt(i);
+    for (unsigned int d = 0; d < 3; ++d)
+    {
+      p[d] = static_cast<typename TMesh::CoordRepType>(sphere.points[3 * i + d]);
+    }
+  }
+  mesh->SetPoints(points);
+  using CellType = typename TMesh::CellType;
+  using TriangleType = itk::TriangleCell<CellType>;
+  const std::size_t numberOfTriangles = sphere.triangles.size() / 3;
+  for (std::size_t t = 0; t < numberOfTriangles; ++t)
+  {
+    typename CellType::CellAutoPointer cell;
+    cell.TakeOwnership(new TriangleType);
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      cell->SetPointId(k, sphere.triangles[3 * t + k]);
+    }
+    mesh->SetCell(t, cell);
+  }
+  return mesh;
+}
+
+constexpr double InitialRadius = 16.0 * PhantomScale;
+constexpr double MeshCentre = 31.0 * PhantomScale;
+
+/** Input mesh of our filter, about \a vertices vertices, cached. */
+const MeshType *
+ModelMesh(int64_t vertices)
+{
+  static std::map<int64_t, MeshType::Pointer> cache;
+  auto &                                      mesh = cache[vertices];
+  if (mesh.IsNull())
+  {
+    mesh = ToITKMesh<MeshType>(MakeGeodesicSphere(SphereFrequency(vertices), InitialRadius, MeshCentre));
+  }
+  return mesh;
+}
+
+/** Iterations per Update(): enough to make the per-update cost (copying the
+ * cells, packing the points) small against the steps. */
+unsigned int
+StepsPerUpdate(int64_t vertices)
+{
+  return vertices >= 1000000 ? 5 : (vertices >= 100000 ? 20 : 100);
+}
+
+// Results for the summary, by benchmark family and size.
+std::map<std::string, double> summaryRates;
+int64_t                       stateBytesPerVertex = -1;
+int64_t                       peakBytesPerVertex = -1;
+
+void
+Record(const std::string & key, double rate)
+{
+  summaryRates[key] = rate;
+}
+
+std::string
+SizeLabel(int64_t vertices)
+{
+  return vertices >= 1000000 ? "1M" : (vertices >= 100000 ? "100k" : "10k");
+}
+
+class ThreadScope
+{
+public:
+  explicit ThreadScope(unsigned int threads)
+    : m_Saved(itk::MultiThreaderBase::GetGlobalDefaultNumberOfThreads())
+  {
+    itk::MultiThreaderBase::SetGlobalDefaultNumberOfThreads(threads);
+  }
+  ~ThreadScope() { itk::MultiThreaderBase::SetGlobalDefaultNumberOfThreads(m_Saved); }
+
+private:
+  unsigned int m_Saved;
+};
+
+// ---------------------------------------------------------------------------
+// Our filter: external forces + Elasticity + Rigidity, tangential elasticity.
+void
+BM_EDM_DeformableMesh(benchmark::State & state)
+{
+  const int64_t      requested = state.range(0);
+  const auto         threads = static_cast<unsigned int>(state.range(1));
+  ThreadScope        scope(threads);
+  const MeshType *   input = ModelMesh(requested);
+  const auto         vertices = static_cast<int64_t>(input->GetNumberOfPoints());
+  const unsigned int steps = StepsPerUpdate(requested);
+
+  auto model = ModelType::New();
+  model->SetInput(input);
+  model->SetForceImage(MeshForceImage());
+  model->SetScaleFactor(0.5);
+  model->SetElasticity(0.3);
+  model->SetRigidity(0.1);
+  model->SetIterateFromZero(false);
+  model->SetNumberOfWorkUnits(threads == 1 ? 1 : 4 * threads);
+  model->SetNumberOfIterations(1);
+  model->Update(); // Reset(): topology and state, outside the timing.
+
+  int64_t stepsRun = 0;
+  for (auto _ : state)
+  {
+    model->SetNumberOfIterations(model->GetCurrentIteration() + steps);
+    model->Update();
+    stepsRun += steps;
+  }
+  state.counters["vertices"] = static_cast<double>(vertices);
+  state.counters["vertex_it/s"] =
+    benchmark::Counter(static_cast<double>(vertices * stepsRun), benchmark::Counter::kIsRate);
+  state.SetLabel("steps/update=" + std::to_string(steps));
+}
+
+// ---------------------------------------------------------------------------
+// ITK's DeformableSimplexMesh3DFilter. The steps are timed without the
+// per-update set-up (Initialize(): neighbour sets for every vertex), the
+// same loop as its GenerateData().
+class SimplexStepper : public SimplexModelType
+{
+public:
+  ITK_DISALLOW_COPY_AND_MOVE(SimplexStepper);
+  using Self = SimplexStepper;
+  using Pointer = itk::SmartPointer<Self>;
+  itkNewMacro(Self);
+
+  void
+  Start()
+  {
+    this->Initialize();
+    this->m_Step = 0;
+  }
+
+  void
+  Steps(unsigned int n)
+  {
+    for (unsigned int k = 0; k < n; ++k)
+    {
+      this->ComputeGeometry();
+      if (this->m_Step % 10 == 0 && this->m_Step > 0)
+      {
+        this->UpdateReferenceMetrics();
+      }
+      this->ComputeDisplacement();
+      ++this->m_Step;
+    }
+  }
+
+  ~SimplexStepper() override
+  {
+    if (this->m_Data.IsNotNull())
+    {
+      for (auto it = this->m_Data->Begin(); it != this->m_Data->End(); ++it)
+      {
+        delete it.Value()->neighborSet;
+        it.Value()->neighborSet = nullptr;
+      }
+    }
+  }
+
+protected:
+  SimplexStepper() = default;
+};
+
+struct SimplexCase
+{
+  SimplexMeshType::Pointer                     mesh;
+  SimplexModelType::GradientImageType::Pointer gradient;
+};
+
+/** Simplex mesh with about \a vertices vertices: dual of a geodesic sphere
+ * with about vertices / 2 vertices (as many triangles as simplex vertices). */
+SimplexMeshType::Pointer
+MakeSimplexMesh(int64_t vertices)
+{
+  const auto triangleMesh =
+    ToITKMesh<TriangleMeshType>(MakeGeodesicSphere(SphereFrequency(vertices / 2), InitialRadius, MeshCentre));
+  using ConverterType = itk::TriangleMeshToSimplexMeshFilter<TriangleMeshType, SimplexMeshType>;
+  auto converter = ConverterType::New();
+  converter->SetInput(triangleMesh);
+  converter->Update();
+  SimplexMeshType::Pointer mesh = converter->GetOutput();
+  mesh->DisconnectPipeline();
+  return mesh;
+}
+
+SimplexModelType::GradientImageType::Pointer
+SimplexGradient()
+{
+  static SimplexModelType::GradientImageType::Pointer gradient = [] {
+    const ForceImageType * field = MeshForceImage();
+    auto                   image = SimplexModelType::GradientImageType::New();
+    image->CopyInformation(field);
+    image->SetRegions(field->GetLargestPossibleRegion());
+    image->Allocate();
+    const auto *      in = field->GetBufferPointer();
+    auto *            out = image->GetBufferPointer();
+    const std::size_t n = field->GetBufferedRegion().GetNumberOfPixels();
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        out[i][d] = in[i][d];
+      }
+    }
+    return image;
+  }();
+  return gradient;
+}
+
+void
+BM_ITK_DeformableSimplexMesh3D(benchmark::State & state)
+{
+  const int64_t requested = state.range(0);
+  // The simplex filter modifies its input's points and geometry: a fresh mesh
+  // each time.
+  SimplexMeshType::Pointer mesh = MakeSimplexMesh(requested);
+  const auto               vertices = static_cast<int64_t>(mesh->GetNumberOfPoints());
+  const unsigned int       steps = requested >= 1000000 ? 1 : (requested >= 100000 ? 2 : 10);
+
+  auto model = SimplexStepper::New();
+  model->SetInput(mesh);
+  model->SetGradient(SimplexGradient());
+  model->SetAlpha(0.2);
+  model->SetBeta(0.5);
+  model->SetGamma(0.05);
+  model->SetRigidity(1);
+  model->Start();
+
+  int64_t stepsRun = 0;
+  for (auto _ : state)
+  {
+    model->Steps(steps);
+    stepsRun += steps;
+  }
+  state.counters["vertices"] = static_cast<double>(vertices);
+  state.counters["vertex_it/s"] =
+    benchmark::Counter(static_cast<double>(vertices * stepsRun), benchmark::Counter::kIsRate);
+  state.SetLabel("serial");
+}
+
+#ifdef EDM_BENCHMARK_WITH_VTK
+// ---------------------------------------------------------------------------
+// The seed's VTK loop: probe the force image at the points, warp the points
+// by the probed vectors, feed the result back.
+vtkSmartPointer<vtkImageData>
+VTKForceImage()
+{
+  static vtkSmartPointer<vtkImageData> image = [] {
+    const ForceImageType * field = MeshForceImage();
+    const auto             size = field->GetLargestPossibleRegion().GetSize();
+    auto                   output = vtkSmartPointer<vtkImageData>::New();
+    output->SetDimensions(static_cast<int>(size[0]), static_cast<int>(size[1]), static_cast<int>(size[2]));
+    output->SetOrigin(field->GetOrigin()[0], field->GetOrigin()[1], field->GetOrigin()[2]);
+    output->SetSpacing(field->GetSpacing()[0], field->GetSpacing()[1], field->GetSpacing()[2]);
+    vtkNew<vtkFloatArray> vectors;
+    vectors->SetName("force");
+    vectors->SetNumberOfComponents(3);
+    const vtkIdType n = static_cast<vtkIdType>(field->GetBufferedRegion().GetNumberOfPixels());
+    vectors->SetNumberOfTuples(n);
+    const auto * in = field->GetBufferPointer();
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      vectors->SetTypedTuple(i, in[i].GetDataPointer());
+    }
+    output->GetPointData()->SetVectors(vectors);
+    return output;
+  }();
+  return image;
+}
+
+void
+BM_VTK_ProbeWarp(benchmark::State & state)
+{
+  const int64_t requested = state.range(0);
+  const auto    threads = static_cast<int>(state.range(1));
+  const auto    sphere = MakeGeodesicSphere(SphereFrequency(requested), InitialRadius, MeshCentre);
+  const auto    vertices = static_cast<vtkIdType>(sphere.points.size() / 3);
+  vtkSMPTools::Initialize(threads);
+
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToFloat();
+  points->SetNumberOfPoints(vertices);
+  for (vtkIdType i = 0; i < vertices; ++i)
+  {
+    points->SetPoint(i, &sphere.points[3 * i]);
+  }
+  vtkNew<vtkCellArray> polys;
+  for (std::size_t t = 0; t < sphere.triangles.size(); t += 3)
+  {
+    const vtkIdType ids[3] = { sphere.triangles[t], sphere.triangles[t + 1], sphere.triangles[t + 2] };
+    polys->InsertNextCell(3, ids);
+  }
+  vtkNew<vtkPolyData> mesh;
+  mesh->SetPoints(points);
+  mesh->SetPolys(polys);
+
+  vtkNew<vtkProbeFilter> probe;
+  probe->SetInputData(mesh);
+  probe->SetSourceData(VTKForceImage());
+  vtkNew<vtkWarpVector> warp;
+  warp->SetInputConnection(probe->GetOutputPort());
+  warp->SetScaleFactor(0.5);
+
+  const unsigned int steps = requested >= 1000000 ? 1 : (requested >= 100000 ? 5 : 20);
+  int64_t            stepsRun = 0;
+  for (auto _ : state)
+  {
+    for (unsigned int k = 0; k < steps; ++k)
+    {
+      warp->Update();
+      mesh->SetPoints(warp->GetOutput()->GetPoints());
+      mesh->Modified();
+    }
+    stepsRun += steps;
+  }
+  state.counters["vertices"] = static_cast<double>(vertices);
+  state.counters["vertex_it/s"] =
+    benchmark::Counter(static_cast<double>(vertices * stepsRun), benchmark::Counter::kIsRate);
+  state.SetLabel("external force only");
+}
+#endif
+
+// ---------------------------------------------------------------------------
+// Force field: ExternalForceImageFilter against two GradientImageFilter passes.
+const ImageType *
+ForceInput(unsigned int size)
+{
+  static std::map<unsigned int, ImageType::Pointer> cache;
+  auto &                                            image = cache[size];
+  if (image.IsNull())
+  {
+    image = MakePhantomImage(size);
+  }
+  return image;
+}
+
+void
+BM_EDM_ExternalForce(benchmark::State & state)
+{
+  const auto        size = static_cast<unsigned int>(state.range(0));
+  const auto        threads = static_cast<unsigned int>(state.range(1));
+  ThreadScope       scope(threads);
+  const ImageType * input = ForceInput(size);
+  auto              forces = ForceFilterType::New();
+  forces->SetInput(input);
+  forces->SetSigma(1.0);
+  forces->SetNumberOfWorkUnits(threads == 1 ? 1 : 4 * threads);
+  for (auto _ : state)
+  {
+    forces->Modified();
+    forces->Update();
+  }
+  const double voxels = static_cast<double>(size) * size * size;
+  state.counters["voxel/s"] = benchmark::Counter(voxels * state.iterations(), benchmark::Counter::kIsRate);
+}
+
+void
+BM_ITK_GradientTwice(benchmark::State & state)
+{
+  const auto        size = static_cast<unsigned int>(state.range(0));
+  const auto        threads = static_cast<unsigned int>(state.range(1));
+  ThreadScope       scope(threads);
+  const ImageType * input = ForceInput(size);
+  using GradientType = itk::GradientImageFilter<ImageType, float, float, ForceImageType>;
+  auto first = GradientType::New();
+  auto second = GradientType::New();
+  first->SetInput(input);
+  second->SetInput(input);
+  first->SetNumberOfWorkUnits(threads == 1 ? 1 : 4 * threads);
+  second->SetNumberOfWorkUnits(threads == 1 ? 1 : 4 * threads);
+  for (auto _ : state)
+  {
+    first->Modified();
+    first->Update();
+    second->Modified();
+    second->Update();
+  }
+  const double voxels = static_cast<double>(size) * size * size;
+  state.counters["voxel/s"] = benchmark::Counter(voxels * state.iterations(), benchmark::Counter::kIsRate);
+}
+
+// ---------------------------------------------------------------------------
+// Memory: heap bytes the filter holds between updates (coordinates, next
+// coordinates, umbrella field, topology, diagnostics), per vertex, measured by
+// deleting the filter and keeping its output. Also the peak during the first
+// update beyond the input and the output.
+void
+BM_EDM_StateMemory(benchmark::State & state)
+{
+  const MeshType * input = ModelMesh(state.range(0));
+  const auto       vertices = static_cast<int64_t>(input->GetNumberOfPoints());
+  int64_t          held = 0;
+  int64_t          peak = 0;
+  for (auto _ : state)
+  {
+    MeshType::Pointer output;
+    int64_t           beforeDeletion = 0;
+    const int64_t     before = liveHeapBytes.load();
+    {
+      auto model = ModelType::New();
+      model->SetInput(input);
+      model->SetForceImage(MeshForceImage());
+      model->SetElasticity(0.3);
+      model->SetRigidity(0.1);
+      model->SetNumberOfIterations(2);
+      peakHeapBytes.store(liveHeapBytes.load());
+      model->Update();
+      peak = peakHeapBytes.load() - before;
+      output = model->GetOutput();
+      output->DisconnectPipeline();
+      beforeDeletion = liveHeapBytes.load();
+    }
+    held = beforeDeletion - liveHeapBytes.load();
+    const int64_t outputBytes = liveHeapBytes.load() - before;
+    peak -= outputBytes;
+  }
+  stateBytesPerVertex = held / vertices;
+  peakBytesPerVertex = peak / vertices;
+  state.counters["vertices"] = static_cast<double>(vertices);
+  state.counters["state_B/vertex"] = static_cast<double>(held) / vertices;
+  state.counters["peak_B/vertex"] = static_cast<double>(peak) / vertices;
+  if (held >= 200 * vertices)
+  {
+    state.SkipWithError("iteration state >= 200 bytes per vertex");
+  }
+}
+
+void
+MeshArguments(benchmark::internal::Benchmark * b, bool threaded)
+{
+  for (const int64_t vertices : { 10000, 100000, 1000000 })
+  {
+    for (const int64_t threads : { 1, 2 })
+    {
+      if (threaded || threads == 1)
+      {
+        b->Args({ vertices, threads });
+      }
+    }
+  }
+  b->ArgNames({ "vertices", "threads" })->UseRealTime()->Unit(benchmark::kMillisecond);
+}
+
+BENCHMARK(BM_EDM_DeformableMesh)->Apply([](benchmark::internal::Benchmark * b) { MeshArguments(b, true); });
+BENCHMARK(BM_ITK_DeformableSimplexMesh3D)->Apply([](benchmark::internal::Benchmark * b) { MeshArguments(b, false); });
+#ifdef EDM_BENCHMARK_WITH_VTK
+BENCHMARK(BM_VTK_ProbeWarp)->Apply([](benchmark::internal::Benchmark * b) { MeshArguments(b, true); });
+#endif
+BENCHMARK(BM_EDM_ExternalForce)
+  ->ArgsProduct({ { 128, 256 }, { 1, 2 } })
+  ->ArgNames({ "size", "threads" })
+  ->UseRealTime()
+  ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ITK_GradientTwice)
+  ->ArgsProduct({ { 128, 256 }, { 1, 2 } })
+  ->ArgNames({ "size", "threads" })
+  ->UseRealTime()
+  ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EDM_StateMemory)->Arg(1000000)->ArgName("vertices")->Iterations(1)->Unit(benchmark::kMillisecond);
+
+/** Console output plus the rates kept for the summary. */
+class SummaryReporter : public benchmark::ConsoleReporter
+{
+public:
+  // Colours only on a terminal, so that redirected output stays plain text.
+  SummaryReporter()
+    : ConsoleReporter(isatty(STDOUT_FILENO) ? OO_ColorTabular : OO_Tabular)
+  {}
+
+  void
+  ReportRuns(const std::vector<Run> & runs) override
+  {
+    for (const Run & run : runs)
+    {
+      for (const char * counter : { "vertex_it/s", "voxel/s" })
+      {
+        const auto it = run.counters.find(counter);
+        if (it != run.counters.end() && !run.error_occurred)
+        {
+          summaryRates[run.benchmark_name()] = it->second.value;
+        }
+      }
+    }
+    ConsoleReporter::ReportRuns(runs);
+  }
+};
+
+double
+Rate(const std::string & name)
+{
+  const auto it = summaryRates.find(name);
+  return it == summaryRates.end() ? 0.0 : it->second;
+}
+
+void
+PrintRatio(const char * what, double numerator, double denominator)
+{
+  if (numerator > 0.0 && denominator > 0.0)
+  {
+    std::printf("  %-52s %8.2f\n", what, numerator / denominator);
+  }
+}
+
+void
+PrintSummary()
+{
+  std::printf("\nSummary (M = millions per second)\n");
+  for (const char * size : { "10000", "100000", "1000000" })
+  {
+    const std::string suffix = std::string("/vertices:") + size;
+    const double      ours1 = Rate("BM_EDM_DeformableMesh" + suffix + "/threads:1/real_time");
+    const double      ours2 = Rate("BM_EDM_DeformableMesh" + suffix + "/threads:2/real_time");
+    const double      simplex = Rate("BM_ITK_DeformableSimplexMesh3D" + suffix + "/threads:1/real_time");
+    const double      vtk1 = Rate("BM_VTK_ProbeWarp" + suffix + "/threads:1/real_time");
+    const double      vtk2 = Rate("BM_VTK_ProbeWarp" + suffix + "/threads:2/real_time");
+    if (ours1 + ours2 + simplex + vtk1 + vtk2 == 0.0)
+    {
+      continue;
+    }
+    std::printf("%s vertices: vertex-iterations/s  EDM 1 thread %.2f M, 2 threads %.2f M; ITK simplex %.2f M; "
+                "VTK probe+warp 1 thread %.2f M, 2 threads %.2f M\n",
+                size,
+                ours1 * 1e-6,
+                ours2 * 1e-6,
+                simplex * 1e-6,
+                vtk1 * 1e-6,
+                vtk2 * 1e-6);
+    PrintRatio("EDM 2 threads / 1 thread", ours2, ours1);
+    PrintRatio("EDM 2 threads / ITK DeformableSimplexMesh3D", ours2, simplex);
+    PrintRatio("EDM 2 threads / VTK probe+warp 2 threads", ours2, vtk2);
+    PrintRatio("EDM 1 thread / ITK DeformableSimplexMesh3D", ours1, simplex);
+    PrintRatio("EDM 1 thread / VTK probe+warp 1 thread", ours1, vtk1);
+  }
+  for (const char * size : { "128", "256" })
+  {
+    for (const char * threads : { "1", "2" })
+    {
+      const std::string suffix = std::string("/size:") + size + "/threads:" + threads + "/real_time";
+      const double      ours = Rate(std::string("BM_EDM_ExternalForce") + suffix);
+      const double      gradient = Rate(std::string("BM_ITK_GradientTwice") + suffix);
+      if (ours > 0.0 || gradient > 0.0)
+      {
+        std::printf("force field %s^3, %s thread(s): ExternalForce %.1f M voxel/s, GradientImageFilter x2 %.1f M "
+                    "voxel/s, ratio %.2f\n",
+                    size,
+                    threads,
+                    ours * 1e-6,
+                    gradient * 1e-6,
+                    gradient > 0.0 ? ours / gradient : 0.0);
+      }
+    }
+  }
+  if (stateBytesPerVertex >= 0)
+  {
+    std::printf("iteration state: %lld bytes per vertex held between updates (limit 200), %lld at the peak of the "
+                "first update beyond input and output\n",
+                static_cast<long long>(stateBytesPerVertex),
+                static_cast<long long>(peakBytesPerVertex));
+  }
+  std::ifstream load("/proc/loadavg");
+  std::string   loadAverage;
+  std::getline(load, loadAverage);
+  std::printf("load average at the end: %s\n", loadAverage.c_str());
+}
+} // namespace
+
+int
+main(int argc, char ** argv)
+{
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv))
+  {
+    return 1;
+  }
+  SummaryReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  benchmark::Shutdown();
+  PrintSummary();
+  return stateBytesPerVertex >= 200 ? EXIT_FAILURE : EXIT_SUCCESS;
+}
