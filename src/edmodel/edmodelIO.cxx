@@ -28,7 +28,11 @@ namespace edm
 namespace
 {
 
-const char * const MeshExtensions = ".vtk, .obj, .off or .gii";
+const char *
+MeshExtensionsText()
+{
+  return HasVTK() ? ".vtk, .obj, .off, .gii, .vtp or .stl" : ".vtk, .obj, .off or .gii";
+}
 
 bool
 IsWritableMeshExtension(const std::string & extension)
@@ -48,89 +52,65 @@ Quote(const std::string & path)
   return "'" + path + "'";
 }
 
-/** The path of the temporary directory of the write in progress, for the
- * signal handler: an interrupted run leaves nothing behind. */
-char g_PendingFile[4096] = { 0 };
-char g_PendingDirectory[4096] = { 0 };
+/** The temporary outputs in progress, for the signal handler: an interrupted
+ * run leaves nothing behind (the handler can only unlink a file and remove an
+ * empty directory: async-signal-safe calls). */
+struct PendingOutput
+{
+  char file[4096];
+  char directory[4096];
+};
+constexpr int MaximumPendingOutputs = 4;
+PendingOutput g_Pending[MaximumPendingOutputs] = {};
 
 extern "C" void
-RemovePendingOutput(int signalNumber)
+RemovePendingOutputs(int signalNumber)
 {
-  if (g_PendingFile[0] != '\0')
+  for (auto & pending : g_Pending)
   {
-    unlink(g_PendingFile);
-  }
-  if (g_PendingDirectory[0] != '\0')
-  {
-    rmdir(g_PendingDirectory);
+    if (pending.file[0] != '\0')
+    {
+      unlink(pending.file);
+    }
+    if (pending.directory[0] != '\0')
+    {
+      rmdir(pending.directory);
+    }
   }
   std::signal(signalNumber, SIG_DFL);
   std::raise(signalNumber);
 }
 
-/** Writes go to DIR/.edmodel-PID-NAME/NAME (same file system, same file name so
- * that ITK picks the same format and multi-file formats such as .mhd + .raw
- * keep consistent names), then every file is renamed into DIR. */
-class AtomicOutput
+int
+RegisterPendingOutput(const std::string & file, const std::string & directory)
 {
-public:
-  explicit AtomicOutput(const std::string & path)
-    : m_Final(path)
+  for (int slot = 0; slot < MaximumPendingOutputs; ++slot)
   {
-    const fs::path finalPath(path);
-    const fs::path directory = finalPath.has_parent_path() ? finalPath.parent_path() : fs::path(".");
-    m_Directory = directory / (".edmodel-" + std::to_string(getpid()) + "-" + finalPath.filename().string());
-    std::error_code error;
-    fs::remove_all(m_Directory, error);
-    if (!fs::create_directory(m_Directory, error))
+    auto & pending = g_Pending[slot];
+    if (pending.directory[0] == '\0' && file.size() < sizeof(pending.file) &&
+        directory.size() < sizeof(pending.directory))
     {
-      throw Error("cannot write " + Quote(path) + ": " + error.message());
-    }
-    m_Temporary = m_Directory / finalPath.filename();
-    std::strncpy(g_PendingDirectory, m_Directory.c_str(), sizeof(g_PendingDirectory) - 1);
-    std::strncpy(g_PendingFile, m_Temporary.c_str(), sizeof(g_PendingFile) - 1);
-    std::signal(SIGINT, RemovePendingOutput);
-    std::signal(SIGTERM, RemovePendingOutput);
-  }
-
-  ~AtomicOutput()
-  {
-    std::error_code error;
-    fs::remove_all(m_Directory, error);
-    g_PendingFile[0] = '\0';
-    g_PendingDirectory[0] = '\0';
-  }
-
-  std::string
-  GetTemporaryPath() const
-  {
-    return m_Temporary.string();
-  }
-
-  void
-  Commit()
-  {
-    const fs::path  destination = fs::path(m_Final).has_parent_path() ? fs::path(m_Final).parent_path() : ".";
-    std::error_code error;
-    for (const auto & entry : fs::directory_iterator(m_Directory))
-    {
-      fs::rename(entry.path(), destination / entry.path().filename(), error);
-      if (error)
-      {
-        throw Error("cannot write " + Quote(m_Final) + ": " + error.message());
-      }
+      std::copy(file.begin(), file.end(), pending.file);
+      pending.file[file.size()] = '\0';
+      std::copy(directory.begin(), directory.end(), pending.directory);
+      pending.directory[directory.size()] = '\0';
+      std::signal(SIGINT, RemovePendingOutputs);
+      std::signal(SIGTERM, RemovePendingOutputs);
+      return slot;
     }
   }
+  return -1;
+}
 
-  AtomicOutput(const AtomicOutput &) = delete;
-  AtomicOutput &
-  operator=(const AtomicOutput &) = delete;
-
-private:
-  std::string m_Final;
-  fs::path    m_Directory;
-  fs::path    m_Temporary;
-};
+void
+UnregisterPendingOutput(int slot)
+{
+  if (slot >= 0)
+  {
+    g_Pending[slot].directory[0] = '\0';
+    g_Pending[slot].file[0] = '\0';
+  }
+}
 
 void
 CheckOutputDirectory(const std::string & path, const std::string & option)
@@ -240,6 +220,53 @@ OneLine(const std::string & text)
   return line.empty() ? std::string("unknown error") : line;
 }
 
+AtomicOutput::AtomicOutput(const std::string & path)
+  : m_Final(path)
+{
+  const fs::path finalPath(path);
+  const fs::path directory = finalPath.has_parent_path() ? finalPath.parent_path() : fs::path(".");
+  const fs::path temporaryDirectory =
+    directory / (".edmodel-" + std::to_string(getpid()) + "-" + finalPath.filename().string());
+  std::error_code error;
+  fs::remove_all(temporaryDirectory, error);
+  if (!fs::create_directory(temporaryDirectory, error))
+  {
+    throw Error("cannot write " + Quote(path) + ": " + error.message());
+  }
+  m_Directory = temporaryDirectory.string();
+  m_Temporary = (temporaryDirectory / finalPath.filename()).string();
+  m_Slot = RegisterPendingOutput(m_Temporary, m_Directory);
+}
+
+AtomicOutput::~AtomicOutput()
+{
+  std::error_code error;
+  fs::remove_all(m_Directory, error);
+  UnregisterPendingOutput(m_Slot);
+}
+
+std::string
+AtomicOutput::GetTemporaryPath() const
+{
+  return m_Temporary;
+}
+
+void
+AtomicOutput::Commit()
+{
+  const fs::path  finalPath(m_Final);
+  const fs::path  destination = finalPath.has_parent_path() ? finalPath.parent_path() : fs::path(".");
+  std::error_code error;
+  for (const auto & entry : fs::directory_iterator(m_Directory))
+  {
+    fs::rename(entry.path(), destination / entry.path().filename(), error);
+    if (error)
+    {
+      throw Error("cannot write " + Quote(m_Final) + ": " + error.message());
+    }
+  }
+}
+
 std::string
 GetExtension(const std::string & path)
 {
@@ -335,14 +362,55 @@ CountSurfaceCells(const MeshType * mesh)
   return count;
 }
 
+namespace
+{
+MeshType::Pointer
+CheckSurfaceMesh(MeshType::Pointer mesh, const std::string & path, const std::string & option)
+{
+  if (mesh->GetNumberOfPoints() == 0)
+  {
+    throw Error(option + ": mesh " + Quote(path) + " has no points");
+  }
+  if (CountSurfaceCells(mesh) == 0)
+  {
+    throw Error(option + ": mesh " + Quote(path) + " has no triangles (a surface mesh is needed)");
+  }
+  return mesh;
+}
+} // namespace
+
 MeshType::Pointer
 ReadMesh(const std::string & path, const std::string & option)
 {
   CheckReadableFile(path, "mesh");
+  const std::string extension = GetExtension(path);
+  if (extension == ".vtp" || extension == ".stl")
+  {
+    if (!HasVTK())
+    {
+      throw Error(option + ": reading " + extension + " needs VTK, and this edmodel was built without VTK (use " +
+                  MeshExtensionsText() + ")");
+    }
+    MeshType::Pointer mesh;
+    try
+    {
+      mesh = ReadPolyDataMesh(path);
+    }
+    catch (const itk::ExceptionObject & exception)
+    {
+      throw Error(option + ": cannot read mesh " + Quote(path) + ": " + OneLine(exception.GetDescription()));
+    }
+    catch (const Error & error)
+    {
+      throw Error(option + ": " + error.what());
+    }
+    return CheckSurfaceMesh(mesh, path, option);
+  }
   itk::MeshIOBase::Pointer io = itk::MeshIOFactory::CreateMeshIO(path.c_str(), itk::IOFileModeEnum::ReadMode);
   if (io.IsNull())
   {
-    throw Error(option + ": cannot read mesh " + Quote(path) + ": unknown mesh format (use " + MeshExtensions + ")");
+    throw Error(option + ": cannot read mesh " + Quote(path) + ": unknown mesh format (use " + MeshExtensionsText() +
+                ")");
   }
   auto reader = itk::MeshFileReader<MeshType>::New();
   reader->SetMeshIO(io);
@@ -357,30 +425,27 @@ ReadMesh(const std::string & path, const std::string & option)
   }
   MeshType::Pointer mesh = reader->GetOutput();
   mesh->DisconnectPipeline();
-  if (mesh->GetNumberOfPoints() == 0)
-  {
-    throw Error(option + ": mesh " + Quote(path) + " has no points");
-  }
-  if (CountSurfaceCells(mesh) == 0)
-  {
-    throw Error(option + ": mesh " + Quote(path) + " has no triangles (a surface mesh is needed)");
-  }
-  return mesh;
+  return CheckSurfaceMesh(mesh, path, option);
 }
 
 void
 CheckMeshOutputPath(const std::string & path, const std::string & option)
 {
   const std::string extension = GetExtension(path);
+  if (extension == ".pvd")
+  {
+    throw Error(option + ": a .pvd file is a time series: write it with --snapshots DIR, and the mesh as " +
+                MeshExtensionsText());
+  }
   if (NeedsVTK(extension) && !HasVTK())
   {
     throw Error(option + ": writing " + extension + " needs VTK, and this edmodel was built without VTK (use " +
-                MeshExtensions + ")");
+                MeshExtensionsText() + ")");
   }
-  if (!IsWritableMeshExtension(extension))
+  if (!IsWritableMeshExtension(extension) && !(NeedsVTK(extension) && HasVTK()))
   {
-    throw Error(option + ": unknown mesh extension '" + extension + "' in " + Quote(path) + " (use " + MeshExtensions +
-                ")");
+    throw Error(option + ": unknown mesh extension '" + extension + "' in " + Quote(path) + " (use " +
+                MeshExtensionsText() + ")");
   }
   CheckOutputDirectory(path, option);
 }
@@ -401,7 +466,20 @@ void
 WriteMesh(const MeshType * mesh, const std::string & path)
 {
   AtomicOutput output(path);
-  auto         writer = itk::MeshFileWriter<MeshType>::New();
+  if (NeedsVTK(GetExtension(path)))
+  {
+    try
+    {
+      WritePolyDataMesh(mesh, output.GetTemporaryPath());
+    }
+    catch (const itk::ExceptionObject & exception)
+    {
+      throw Error("cannot write mesh " + Quote(path) + ": " + OneLine(exception.GetDescription()));
+    }
+    output.Commit();
+    return;
+  }
+  auto writer = itk::MeshFileWriter<MeshType>::New();
   writer->SetInput(mesh);
   writer->SetFileName(output.GetTemporaryPath());
   try
@@ -451,3 +529,20 @@ WriteImage(const ForceImageType * image, const std::string & path)
 }
 
 } // namespace edm
+
+#ifndef EDM_HAVE_VTK
+namespace edm
+{
+// Without VTK, .vtp and .stl are refused before these are reached.
+MeshType::Pointer
+ReadPolyDataMesh(const std::string & path)
+{
+  throw Error("cannot read mesh '" + path + "': this edmodel was built without VTK");
+}
+void
+WritePolyDataMesh(const MeshType *, const std::string & path)
+{
+  throw Error("cannot write mesh '" + path + "': this edmodel was built without VTK");
+}
+} // namespace edm
+#endif

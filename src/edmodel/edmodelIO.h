@@ -25,7 +25,7 @@ using MeshType = itk::Mesh<double, 3, itk::DefaultStaticMeshTraits<double, 3, 3,
 ImageType::Pointer
 ReadImage(const std::string & path);
 
-/** Reads a surface mesh (.vtk, .obj, .off, .gii). \a option names the
+/** Reads a surface mesh (.vtk, .obj, .off, .gii; .vtp and .stl with VTK). \a option names the
  * command-line option in messages. Throws Error when the file is missing,
  * unreadable, of an unknown format or has no triangle or polygon. */
 MeshType::Pointer
@@ -34,6 +34,12 @@ ReadMesh(const std::string & path, const std::string & option);
 /** Number of triangles and polygons of a mesh. */
 size_t
 CountSurfaceCells(const MeshType * mesh);
+
+/** Mesh files through VTK (.vtp, .stl), defined only when built with VTK. */
+MeshType::Pointer
+ReadPolyDataMesh(const std::string & path);
+void
+WritePolyDataMesh(const MeshType * mesh, const std::string & path);
 
 /** Checks, before any computation, that \a path can take a mesh: a known
  * extension and an existing directory. Throws Error otherwise. */
@@ -52,6 +58,61 @@ void
 WriteImage(const ImageType * image, const std::string & path);
 void
 WriteImage(const ForceImageType * image, const std::string & path);
+
+/** A file written through a temporary directory beside it,
+ * DIR/.edmodel-PID-NAME/NAME (same file system, same file name so that
+ * writers pick the same format and multi-file formats such as .mhd + .raw or
+ * a .pvd series keep consistent names). Commit() renames every file of the
+ * temporary directory into DIR; otherwise the destructor (or SIGINT, SIGTERM)
+ * removes them: a failed run leaves no partial output. */
+class AtomicOutput
+{
+public:
+  explicit AtomicOutput(const std::string & path);
+  ~AtomicOutput();
+  AtomicOutput(const AtomicOutput &) = delete;
+  AtomicOutput &
+  operator=(const AtomicOutput &) = delete;
+
+  /** Where to write: DIR/.edmodel-PID-NAME/NAME. */
+  std::string
+  GetTemporaryPath() const;
+
+  void
+  Commit();
+
+private:
+  std::string m_Final;
+  std::string m_Directory;
+  std::string m_Temporary;
+  int         m_Slot{ -1 };
+};
+
+/** Writes every K-th iteration of a deformation as .vtp files and a ParaView
+ * .pvd collection DIRECTORY/NAME.pvd (needs VTK). The files appear when
+ * Commit() succeeds. */
+class SnapshotSeries
+{
+public:
+  SnapshotSeries(const std::string & directory, const std::string & name);
+  ~SnapshotSeries();
+  SnapshotSeries(const SnapshotSeries &) = delete;
+  SnapshotSeries &
+  operator=(const SnapshotSeries &) = delete;
+
+  void
+  Add(const MeshType * mesh, itk::SizeValueType iteration);
+  void
+  Commit();
+  std::string
+  GetCollectionPath() const;
+  unsigned int
+  GetNumberOfFiles() const;
+
+private:
+  struct Internals;
+  Internals * m_Internals;
+};
 
 /** "a.b.c" -> ".c", "a.nii.gz" -> ".nii.gz", lower case. */
 std::string

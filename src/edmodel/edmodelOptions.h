@@ -46,8 +46,8 @@ constexpr double       ConvergenceTolerance = 0.01;
 constexpr unsigned int ConvergenceWindow = 5;
 constexpr bool         NormalizeForces = true;
 constexpr bool         GradientVectorFlow = false;
-constexpr double       GradientVectorFlowRegularization = 0.2;
-constexpr unsigned int GradientVectorFlowIterations = 200;
+constexpr double       GradientVectorFlowRegularization = 0.1;
+constexpr unsigned int GradientVectorFlowIterations = 400;
 /** Subdivisions of the octahedron of --init-sphere (4 * 4^n + 2 points). */
 constexpr unsigned int SphereResolution = 4;
 /** Radius of the default initial sphere, as a fraction of the smallest

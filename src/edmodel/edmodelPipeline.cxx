@@ -17,6 +17,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
+#include <memory>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -263,9 +265,16 @@ struct DeformResult
   double                  lastMaximumDisplacement{ 0.0 };
 };
 
+/** Called with the mesh of every K-th iteration (and of the first and last). */
+using SnapshotCallback = std::function<void(const MeshType *, itk::SizeValueType)>;
+
 /** The force field and the deformation, by the ITK filters. */
 DeformResult
-Deform(const ImageType * image, const MeshType * initial, const SegmentOptions & o, Progress & progress)
+Deform(const ImageType *        image,
+       const MeshType *         initial,
+       const SegmentOptions &   o,
+       Progress &               progress,
+       const SnapshotCallback & snapshot = SnapshotCallback())
 {
   DeformResult result;
   result.sigma = o.sigma >= 0.0 ? o.sigma : defaults::SigmaInVoxels * SmallestSpacing(image);
@@ -312,7 +321,21 @@ Deform(const ImageType * image, const MeshType * initial, const SegmentOptions &
                     "iteration " + std::to_string(current) + "/" + std::to_string(total) + ", largest step " +
                       Format(deform->GetLastMaximumDisplacement()) + " mm");
   });
+  if (snapshot)
+  {
+    snapshot(initial, 0);
+    deform->AddObserver(itk::IterationEvent(), [&](const itk::EventObject &) {
+      if (deform->GetCurrentIteration() % o.snapshotEvery == 0)
+      {
+        snapshot(deform->GetOutput(), deform->GetCurrentIteration());
+      }
+    });
+  }
   deform->Update();
+  if (snapshot && deform->GetCurrentIteration() % o.snapshotEvery != 0)
+  {
+    snapshot(deform->GetOutput(), deform->GetCurrentIteration());
+  }
   result.mesh = deform->GetOutput();
   result.mesh->DisconnectPipeline();
   result.iterations = deform->GetCurrentIteration();
@@ -358,15 +381,30 @@ GetLibraryVersions()
 int
 RunSegment(const SegmentOptions & o, const GlobalOptions & global)
 {
+  namespace fs = std::filesystem;
   // Every output is checked before the long computation starts.
   CheckMeshOutputPath(o.output, "--output");
   if (!o.forceOutput.empty())
   {
     CheckImageOutputPath(o.forceOutput, "--force-output");
   }
-  if (!o.snapshots.empty() && !HasVTK())
+  if (!o.snapshots.empty())
   {
-    throw Error("--snapshots: the .pvd time series needs VTK, and this edmodel was built without VTK");
+    if (!HasVTK())
+    {
+      throw Error("--snapshots: the .pvd time series needs VTK, and this edmodel was built without VTK");
+    }
+    const fs::path  directory(o.snapshots);
+    std::error_code error;
+    if (fs::exists(directory, error) && !fs::is_directory(directory, error))
+    {
+      throw Error("--snapshots: '" + o.snapshots + "' is not a directory");
+    }
+    const fs::path parent = directory.has_parent_path() ? directory.parent_path() : fs::path(".");
+    if (!fs::is_directory(parent, error))
+    {
+      throw Error("--snapshots: directory '" + parent.string() + "' does not exist");
+    }
   }
 
   Progress           progress(global.quiet);
@@ -387,13 +425,30 @@ RunSegment(const SegmentOptions & o, const GlobalOptions & global)
                 Format(image->GetSpacing()[2]) + " mm; initial mesh " + std::to_string(initial->GetNumberOfPoints()) +
                 " points");
 
-  const DeformResult result = Deform(image, initial, o, progress);
+  std::unique_ptr<SnapshotSeries> series;
+  SnapshotCallback                snapshot;
+#ifdef EDM_HAVE_VTK
+  if (!o.snapshots.empty())
+  {
+    // The series is named after the output mesh: out/liver.vtk -> DIR/liver.pvd.
+    series = std::make_unique<SnapshotSeries>(o.snapshots, fs::path(o.output).stem().string());
+    snapshot = [&series](const MeshType * mesh, itk::SizeValueType iteration) { series->Add(mesh, iteration); };
+  }
+#endif
+
+  const DeformResult result = Deform(image, initial, o, progress, snapshot);
 
   if (!o.forceOutput.empty())
   {
     WriteImage(result.force, o.forceOutput);
   }
   WriteMesh(result.mesh, o.output);
+  if (series)
+  {
+    series->Commit();
+    progress.Note("wrote " + std::to_string(series->GetNumberOfFiles()) + " snapshots, every " +
+                  std::to_string(o.snapshotEvery) + " iterations: " + series->GetCollectionPath());
+  }
   if (!global.quiet)
   {
     std::cout << "edmodel: wrote " << o.output << " (" << result.mesh->GetNumberOfPoints() << " points, "
@@ -449,12 +504,25 @@ RunDemo(const DemoOptions & options, const GlobalOptions & global)
   Progress progress(global.quiet);
   progress.Note("demo: 64^3 binary ellipsoid of radii (18, 14, 28) voxels centred at (31, 31, 31); sphere of radius " +
                 Format(sphereRadius) + " at the centre, " + std::to_string(sphere->GetNumberOfPoints()) + " points");
-  const DeformResult result = Deform(image, sphere, segment, progress);
+  std::unique_ptr<SnapshotSeries> series;
+  SnapshotCallback                snapshot;
+#ifdef EDM_HAVE_VTK
+  series = std::make_unique<SnapshotSeries>((directory / "series").string(), "demo");
+  snapshot = [&series](const MeshType * mesh, itk::SizeValueType iteration) { series->Add(mesh, iteration); };
+#endif
+  const DeformResult result = Deform(image, sphere, segment, progress, snapshot);
 
   WriteImage(image, imagePath);
   WriteImage(result.force, forcePath);
   WriteMesh(sphere, spherePath);
   WriteMesh(result.mesh, meshPath);
+  std::string written = imagePath + ", " + forcePath + ", " + spherePath + ", " + meshPath;
+  if (series)
+  {
+    series->Commit();
+    written += ", " + series->GetCollectionPath() + " (" + std::to_string(series->GetNumberOfFiles()) +
+               " snapshots, open it in ParaView)";
+  }
 
   double mean = 0.0;
   double maximum = 0.0;
@@ -473,7 +541,7 @@ RunDemo(const DemoOptions & options, const GlobalOptions & global)
             << Format(maximum) << " voxel\n"
             << "  accuracy " << (good ? "good" : "POOR") << " (limits: mean < " << DemoMeanDistanceLimit
             << " voxel, max < " << DemoMaximumDistanceLimit << " voxel)\n"
-            << "  wrote " << imagePath << ", " << forcePath << ", " << spherePath << ", " << meshPath << "\n"
+            << "  wrote " << written << "\n"
             << "  same run by hand: edmodel segment --image " << imagePath << " --init-sphere 31,31,31,16"
             << (segment.gradientVectorFlow ? " --gvf" : "") << " --output " << (directory / "mesh.vtk").string()
             << "\n";

@@ -1,5 +1,5 @@
-# edmodel demo: exit code 0 (accuracy good), the files it promises, and the
-# accuracy figures on stdout.
+# edmodel demo: exit code 0 (accuracy good), the files it promises (the .pvd
+# series when built with VTK), and the accuracy figures on stdout.
 cmake_minimum_required(VERSION 3.16)
 file(REMOVE_RECURSE "${WORK}")
 execute_process(COMMAND ${EDMODEL} demo --output-dir ${WORK}/out RESULT_VARIABLE rc OUTPUT_VARIABLE out
@@ -13,6 +13,10 @@ foreach(file demo-image.nii.gz demo-force.mha demo-sphere.vtk demo-mesh.vtk)
     message(FATAL_ERROR "edmodel demo did not write ${file}")
   endif()
 endforeach()
+execute_process(COMMAND ${EDMODEL} --version OUTPUT_VARIABLE version)
+if(version MATCHES "with VTK" AND NOT EXISTS ${WORK}/out/series/demo.pvd)
+  message(FATAL_ERROR "edmodel demo, built with VTK, did not write series/demo.pvd")
+endif()
 if(NOT out MATCHES "final mesh: +mean [0-9.e-]+ voxel, max [0-9.e-]+ voxel" OR NOT out MATCHES "accuracy good")
   message(FATAL_ERROR "edmodel demo did not report its accuracy")
 endif()

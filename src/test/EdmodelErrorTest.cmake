@@ -5,6 +5,8 @@
 # SETUP, SETUP2: optional helper commands (edmodelTestTool arguments).
 # GARBAGE: optional file to fill with text that is no image or mesh.
 # ARGS: edmodel arguments. ABSENT: files that must not exist afterwards.
+# WITH_VTK_PRESENT: for the errors of a build without VTK: when edmodel is
+# built with VTK, the run must succeed instead and write these files.
 cmake_minimum_required(VERSION 3.16)
 include(${CMAKE_CURRENT_LIST_DIR}/EdmodelTestCommon.cmake)
 
@@ -26,6 +28,19 @@ endif()
 edm_expand(arguments "${ARGS}")
 execute_process(COMMAND ${EDMODEL} ${arguments} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 message(STATUS "edmodel ${arguments}\nexit code ${rc}\nstderr: ${err}stdout: ${out}")
+if(WITH_VTK_PRESENT AND EDM_WITH_VTK)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "built with VTK, edmodel should succeed here")
+  endif()
+  edm_expand(present "${WITH_VTK_PRESENT}")
+  foreach(file IN LISTS present)
+    if(NOT EXISTS "${file}")
+      message(FATAL_ERROR "edmodel did not write ${file}")
+    endif()
+  endforeach()
+  edm_check_no_leftovers()
+  return()
+endif()
 if(NOT rc STREQUAL "${EXPECT_RC}")
   message(FATAL_ERROR "exit code ${rc}, expected ${EXPECT_RC}")
 endif()

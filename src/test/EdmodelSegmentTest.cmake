@@ -7,9 +7,17 @@
 # SEGMENT: edmodel arguments.
 # OUTPUT: the mesh edmodel writes, measured with MEASURE (edmodelTestTool
 # measure arguments after the path).
+# CONVERT: optional edmodel arguments run after the segmentation that turn
+# OUTPUT into MEASURED (a format the measuring tool reads), then measured.
+# PRESENT: optional files that must exist afterwards.
+# REQUIRES_VTK: skip (message "test skipped") when edmodel is built without VTK.
 cmake_minimum_required(VERSION 3.16)
 include(${CMAKE_CURRENT_LIST_DIR}/EdmodelTestCommon.cmake)
 
+if(REQUIRES_VTK AND NOT EDM_WITH_VTK)
+  message(STATUS "edmodel test skipped: edmodel is built without VTK")
+  return()
+endif()
 edm_fresh_work()
 edm_run_helper("${TOOL}|${PHANTOM}")
 if(SETUP)
@@ -34,6 +42,22 @@ if(NOT EXISTS "${output}")
   message(FATAL_ERROR "no output mesh ${output}")
 endif()
 edm_check_no_leftovers()
+
+edm_expand(present "${PRESENT}")
+foreach(file IN LISTS present)
+  if(NOT EXISTS "${file}")
+    message(FATAL_ERROR "edmodel did not write ${file}")
+  endif()
+endforeach()
+
+if(CONVERT)
+  edm_expand(convert "${CONVERT}")
+  execute_process(COMMAND ${EDMODEL} ${convert} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "edmodel ${convert} exited with ${rc}\n${err}")
+  endif()
+  edm_expand(output "${MEASURED}")
+endif()
 
 edm_expand(measure "${MEASURE}")
 execute_process(COMMAND ${TOOL} measure ${output} ${measure} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)

@@ -30,3 +30,11 @@ function(edm_check_no_leftovers)
     message(FATAL_ERROR "temporary output left behind: ${leftovers}")
   endif()
 endfunction()
+
+# EDM_WITH_VTK: whether this edmodel writes .vtp, .stl and .pvd.
+execute_process(COMMAND ${EDMODEL} --version OUTPUT_VARIABLE _edm_version RESULT_VARIABLE _edm_rc)
+if(_edm_version MATCHES "with VTK")
+  set(EDM_WITH_VTK ON)
+else()
+  set(EDM_WITH_VTK OFF)
+endif()
