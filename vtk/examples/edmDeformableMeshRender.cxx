@@ -25,9 +25,10 @@
 //
 // Usage: edmDeformableMeshRender [--png figure.png] [--iterations N]
 //                                [--series dir/name.pvd [--interval K]]
+//                                [--offscreen] [--exit-when-done]
 // - with a display and no --png: an interactive window; a timer runs one more
 //   iteration per frame up to N (IterateFromZero off), then the window stays
-//   open for inspection;
+//   open for inspection (or closes with --exit-when-done);
 // - otherwise: Figure 1 offscreen: four views of the mesh (wireframe, and its
 //   cut in red) over the image slice y = 31 at iterations 0, 10, 50 and N (default 200), written to a PNG
 //   (default DeformableMesh.png);
@@ -155,14 +156,19 @@ struct Animation
   vtkRenderWindow *   Window;
   vtkTextActor *      Label;
   int                 LastIteration;
+  bool                ExitWhenDone;
 };
 
 void
-NextFrame(vtkObject *, unsigned long, void * clientData, void *)
+NextFrame(vtkObject * caller, unsigned long, void * clientData, void *)
 {
   auto * animation = static_cast<Animation *>(clientData);
   if (animation->Deformable->GetNumberOfIterations() >= animation->LastIteration)
   {
+    if (animation->ExitWhenDone)
+    {
+      static_cast<vtkRenderWindowInteractor *>(caller)->TerminateApp();
+    }
     return;
   }
   animation->Deformable->SetNumberOfIterations(animation->Deformable->GetNumberOfIterations() + 1);
@@ -249,7 +255,7 @@ main(int argc, char * argv[])
     vtkNew<vtkRenderWindowInteractor> interactor;
     interactor->SetRenderWindow(window);
     window->Render();
-    Animation                  animation{ deformable, window, label, lastIteration };
+    Animation animation{ deformable, window, label, lastIteration, HasFlag(argc, argv, "--exit-when-done") };
     vtkNew<vtkCallbackCommand> frame;
     frame->SetCallback(NextFrame);
     frame->SetClientData(&animation);
@@ -257,7 +263,10 @@ main(int argc, char * argv[])
     interactor->Initialize();
     interactor->CreateRepeatingTimer(20);
     interactor->Start();
-    return EXIT_SUCCESS;
+    const double distance = MeanDistance(deformable->GetOutput());
+    std::cout << "iteration " << deformable->GetCurrentIteration() << ": mean distance to the ellipsoid " << distance
+              << " voxel" << std::endl;
+    return deformable->GetCurrentIteration() == lastIteration && distance < 0.5 ? EXIT_SUCCESS : EXIT_FAILURE;
   }
 
   // Figure 1: the mesh at iterations 0, 10, 50 and the last, one more step

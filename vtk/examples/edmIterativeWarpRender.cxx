@@ -21,7 +21,7 @@
 // IterateFromZero off so that each frame costs one step.
 //
 // Usage: edmIterativeWarpRender [--png file.png] [--iterations N]
-//                               [--step-length s] [--seed k]
+//                               [--step-length s] [--seed k] [--offscreen]
 // - with a display and no --png: an interactive window; a timer raises
 //   NumberOfIterations by one and renders, until the window is closed (or N
 //   iterations when --iterations is given);
@@ -164,7 +164,8 @@ main(int argc, char * argv[])
     interactor->Initialize();
     interactor->CreateRepeatingTimer(30);
     interactor->Start();
-    return EXIT_SUCCESS;
+    std::cout << "Stopped at iteration " << warp->GetCurrentIteration() << std::endl;
+    return requested == 0 || warp->GetCurrentIteration() == requested ? EXIT_SUCCESS : EXIT_FAILURE;
   }
 
   if (!HasDisplay() && !CanRenderWithoutDisplay(window))

@@ -51,6 +51,7 @@
 
 #include "gtest/gtest.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -575,6 +576,51 @@ TEST(VTKIterativeAlgorithms, WrongInputsGiveAnErrorAndAnEmptyOutput)
   warp->Update();
   EXPECT_GE(warpErrors.Count(), 1);
   EXPECT_EQ(warp->GetOutput()->GetNumberOfPoints(), 0);
+}
+
+TEST(VTKIterativeAlgorithms, ProgressIsReportedAndAbortStopsBetweenSteps)
+{
+  auto                 sphere = MakeSphere(2.0, Origin);
+  vtkNew<CountingWarp> warp;
+  warp->SetInputData(sphere);
+  warp->IterateFromZeroOff();
+  warp->SetNumberOfIterations(20);
+
+  struct Observed
+  {
+    std::vector<double> Progress;
+    vtkAlgorithm *      Algorithm;
+    double              AbortAt;
+  } observed{ {}, warp, 0.5 };
+  vtkNew<vtkCallbackCommand> onProgress;
+  onProgress->SetClientData(&observed);
+  onProgress->SetCallback([](vtkObject *, unsigned long, void * clientData, void * callData) {
+    auto *       self = static_cast<Observed *>(clientData);
+    const double progress = *static_cast<double *>(callData);
+    self->Progress.push_back(progress);
+    if (progress >= self->AbortAt)
+    {
+      self->Algorithm->SetAbortExecute(1);
+    }
+  });
+  warp->AddObserver(vtkCommand::ProgressEvent, onProgress);
+  warp->Update();
+  // Progress rises, and the abort request stops the ITK filter after the step
+  // that reported half of the work.
+  ASSERT_GE(observed.Progress.size(), 2u);
+  EXPECT_TRUE(std::is_sorted(observed.Progress.begin(), observed.Progress.end()));
+  EXPECT_EQ(warp->TakeSteps(), 10);
+  EXPECT_EQ(warp->GetCurrentIteration(), 10);
+  EXPECT_EQ(Coordinates(warp->GetOutput()), ReferenceWarp(sphere, 10, 1.0, 0));
+
+  // Resuming (Modified, as with the ITK filter) runs the remaining steps.
+  observed.AbortAt = 2.0;
+  warp->SetAbortExecute(0);
+  warp->Modified();
+  warp->Update();
+  EXPECT_EQ(warp->TakeSteps(), 10);
+  EXPECT_EQ(warp->GetCurrentIteration(), 20);
+  EXPECT_EQ(Coordinates(warp->GetOutput()), ReferenceWarp(sphere, 20, 1.0, 0));
 }
 
 TEST(VTKIterativeAlgorithms, PrintSelfPrintsEveryParameter)
