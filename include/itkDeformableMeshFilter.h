@@ -149,6 +149,10 @@ public:
    * normal per iteration, in physical units. Positive inflates, negative
    * deflates. "Outward" is decided from the signed volume of the mesh, so an
    * inward-oriented closed mesh behaves the same as an outward-oriented one.
+   * The balloon carries each vertex to an edge: once the external force
+   * opposes it at least as strongly (the vertex has reached the edge's capture
+   * range), it is released for that vertex until the next reset, so that the
+   * vertex settles on the edge rather than where the two forces balance.
    * Must be finite. Default: 0. */
   itkSetMacro(Balloon, double);
   itkGetConstMacro(Balloon, double);
@@ -167,7 +171,7 @@ public:
 
   /** Number of consecutive iterations whose largest displacement must stay
    * below ConvergenceTolerance to declare convergence. At least 1.
-   * Default: 5. */
+   * Default: 3. */
   itkSetClampMacro(ConvergenceWindow, unsigned int, 1, NumericTraits<unsigned int>::max());
   itkGetConstMacro(ConvergenceWindow, unsigned int);
 
@@ -251,7 +255,7 @@ private:
   double       m_Balloon{ 0.0 };
   double       m_MaximumStepLength{ 0.0 };
   double       m_ConvergenceTolerance{ 0.0 };
-  unsigned int m_ConvergenceWindow{ 5 };
+  unsigned int m_ConvergenceWindow{ 3 };
 
   bool         m_Converged{ false };
   unsigned int m_QuietIterations{ 0 };
@@ -266,11 +270,12 @@ private:
   std::vector<IndexType32> m_VertexTriangles;
 
   // Per-vertex state.
-  std::vector<double> m_NextCoordinates;
-  std::vector<double> m_Umbrella;
-  std::vector<float>  m_DisplacementMagnitudes;
-  std::vector<float>  m_ExternalForceMagnitudes;
-  std::vector<float>  m_InternalForceMagnitudes;
+  std::vector<double>  m_NextCoordinates;
+  std::vector<double>  m_Umbrella;
+  std::vector<uint8_t> m_BalloonReleased;
+  std::vector<float>   m_DisplacementMagnitudes;
+  std::vector<float>   m_ExternalForceMagnitudes;
+  std::vector<float>   m_InternalForceMagnitudes;
 
   // Force sampler, prepared at each update.
   const ForcePixelType * m_ForceBuffer{ nullptr };

@@ -305,6 +305,7 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
   m_NextCoordinates.resize(3 * numberOfPoints);
   std::vector<double>().swap(m_Umbrella);
+  m_BalloonReleased.clear();
   m_DisplacementMagnitudes.clear();
   m_ExternalForceMagnitudes.clear();
   m_InternalForceMagnitudes.clear();
@@ -366,9 +367,14 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
     m_ExternalForceMagnitudes.assign(numberOfPoints, 0.0f);
     m_InternalForceMagnitudes.assign(numberOfPoints, 0.0f);
   }
-  float * displacementMagnitudes = m_DisplacementMagnitudes.data();
-  float * externalMagnitudes = m_ExternalForceMagnitudes.data();
-  float * internalMagnitudes = m_InternalForceMagnitudes.data();
+  if (m_BalloonReleased.size() != numberOfPoints)
+  {
+    m_BalloonReleased.assign(numberOfPoints, 0);
+  }
+  uint8_t * balloonReleased = m_BalloonReleased.data();
+  float *   displacementMagnitudes = m_DisplacementMagnitudes.data();
+  float *   externalMagnitudes = m_ExternalForceMagnitudes.data();
+  float *   internalMagnitudes = m_InternalForceMagnitudes.data();
 
   // Umbrella vector: centroid of the neighbours minus the vertex.
   auto umbrella = [x, offsets, neighbours](SizeValueType i, double * u) {
@@ -482,9 +488,26 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
             internal[2] -= rigidity * (mean[2] * inverseCount - u[2]);
           }
         }
-        delta[0] += internal[0] + balloon * normal[0];
-        delta[1] += internal[1] + balloon * normal[1];
-        delta[2] += internal[2] + balloon * normal[2];
+        // The balloon carries a vertex to an edge, not past it: once the
+        // external force opposes it at least as strongly, the vertex is in the
+        // edge's capture range and the balloon is released for it, so that it
+        // settles on the edge itself instead of where the two forces balance.
+        double inflation = 0.0;
+        if (balloon != 0.0 && !balloonReleased[i])
+        {
+          const double externalAlongNormal = delta[0] * normal[0] + delta[1] * normal[1] + delta[2] * normal[2];
+          if (balloon * externalAlongNormal <= -balloon * balloon)
+          {
+            balloonReleased[i] = 1;
+          }
+          else
+          {
+            inflation = balloon;
+          }
+        }
+        delta[0] += internal[0] + inflation * normal[0];
+        delta[1] += internal[1] + inflation * normal[1];
+        delta[2] += internal[2] + inflation * normal[2];
 
         double length = std::sqrt(delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2]);
         if (maximumStep > 0.0 && length > maximumStep)

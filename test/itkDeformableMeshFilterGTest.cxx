@@ -480,7 +480,7 @@ TEST(DeformableMeshFilter, PrintsEveryParameter)
                                "Balloon: -0.125",
                                "MaximumStepLength: 0",
                                "ConvergenceTolerance: 0",
-                               "ConvergenceWindow: 5",
+                               "ConvergenceWindow: 3",
                                "Converged: false",
                                "OrientationSign: 1" })
   {
