@@ -544,5 +544,30 @@ WritePolyDataMesh(const MeshType *, const std::string & path)
 {
   throw Error("cannot write mesh '" + path + "': this edmodel was built without VTK");
 }
+
+struct SnapshotSeries::Internals
+{};
+SnapshotSeries::SnapshotSeries(const std::string &, const std::string &)
+  : m_Internals(nullptr)
+{
+  throw Error("--snapshots: the .pvd time series needs VTK, and this edmodel was built without VTK");
+}
+SnapshotSeries::~SnapshotSeries() = default;
+void
+SnapshotSeries::Add(const MeshType *, itk::SizeValueType)
+{}
+void
+SnapshotSeries::Commit()
+{}
+std::string
+SnapshotSeries::GetCollectionPath() const
+{
+  return std::string();
+}
+unsigned int
+SnapshotSeries::GetNumberOfFiles() const
+{
+  return 0;
+}
 } // namespace edm
 #endif
