@@ -486,6 +486,37 @@ TEST(VTKIterativeAlgorithms, DeformableMeshContinuesStepByStep)
   EXPECT_EQ(deformable->TakeSteps(), 1);
 }
 
+TEST(VTKIterativeAlgorithms, DeformableMeshStopsAtConvergence)
+{
+  const auto forces = MakeForces();
+  auto       forceImage = edm::ImageToImageData(forces.GetPointer(), "Force");
+  auto       sphere = MakeSphere(11.0, Center);
+
+  vtkNew<vtkDeformableMesh> deformable;
+  deformable->SetInputData(sphere);
+  deformable->SetForceImageData(forceImage);
+  deformable->SetScaleFactor(0.5);
+  deformable->SetConvergenceTolerance(0.01);
+  deformable->SetConvergenceWindow(3);
+  deformable->SetNumberOfIterations(1000);
+  deformable->Update();
+  EXPECT_TRUE(deformable->GetConverged());
+  EXPECT_LT(deformable->GetCurrentIteration(), 1000);
+  EXPECT_LT(deformable->GetLastMaximumDisplacement(), 0.01);
+
+  auto filter = itk::DeformableMeshFilter<MeshType, ForceImageType>::New();
+  filter->SetInput(ToITK(sphere));
+  filter->SetForceImage(forces);
+  filter->SetScaleFactor(0.5);
+  filter->SetConvergenceTolerance(0.01);
+  filter->SetConvergenceWindow(3);
+  filter->SetNumberOfIterations(1000);
+  filter->Update();
+  EXPECT_EQ(static_cast<itk::SizeValueType>(deformable->GetCurrentIteration()), filter->GetCurrentIteration());
+  EXPECT_EQ(Coordinates(deformable->GetOutput()), Coordinates(filter->GetOutput()));
+  std::cout << "converged at iteration " << deformable->GetCurrentIteration() << std::endl;
+}
+
 TEST(VTKIterativeAlgorithms, DeformableMeshUsesTheArrayToProcess)
 {
   const auto forces = MakeForces();
