@@ -213,6 +213,13 @@ std::string
 OneLine(const std::string & text)
 {
   std::string line = text.substr(0, text.find_first_of("\r\n"));
+  // "ITK ERROR: MeshFileReader(0x5581...): message" -> "message"
+  const std::string prefix = "ITK ERROR: ";
+  const auto        object = line.find("): ");
+  if (line.compare(0, prefix.size(), prefix) == 0 && object != std::string::npos)
+  {
+    line = line.substr(object + 3);
+  }
   while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back())))
   {
     line.pop_back();

@@ -292,7 +292,14 @@ Deform(const ImageType *        image,
   force->AddObserver(itk::ProgressEvent(),
                      [&](const itk::EventObject &) { progress.Update(force->GetProgress(), ""); });
   const auto start = std::chrono::steady_clock::now();
-  force->Update();
+  try
+  {
+    force->Update();
+  }
+  catch (const itk::ExceptionObject & exception)
+  {
+    throw Error("force field: " + OneLine(exception.GetDescription()));
+  }
   result.force = force->GetOutput();
   const auto seconds = [&start]() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -331,7 +338,14 @@ Deform(const ImageType *        image,
       }
     });
   }
-  deform->Update();
+  try
+  {
+    deform->Update();
+  }
+  catch (const itk::ExceptionObject & exception)
+  {
+    throw Error("deformation: " + OneLine(exception.GetDescription()));
+  }
   if (snapshot && deform->GetCurrentIteration() % o.snapshotEvery != 0)
   {
     snapshot(deform->GetOutput(), deform->GetCurrentIteration());
