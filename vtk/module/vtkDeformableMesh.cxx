@@ -64,6 +64,16 @@ vtkDeformableMesh::vtkDeformableMesh()
   this->SetNumberOfInputPorts(2);
   this->DeformableInternals->Filter = vtkDeformableMeshInternals::FilterType::New();
   this->Internals->Filter = this->DeformableInternals->Filter.GetPointer();
+  // The defaults are the ITK filter's, so that both faces stay the same.
+  const auto * filter = this->DeformableInternals->Filter.GetPointer();
+  this->ScaleFactor = filter->GetScaleFactor();
+  this->Elasticity = filter->GetElasticity();
+  this->TangentialElasticity = filter->GetTangentialElasticity() ? 1 : 0;
+  this->Rigidity = filter->GetRigidity();
+  this->Balloon = filter->GetBalloon();
+  this->MaximumStepLength = filter->GetMaximumStepLength();
+  this->ConvergenceTolerance = filter->GetConvergenceTolerance();
+  this->ConvergenceWindow = static_cast<int>(filter->GetConvergenceWindow());
   this->SetInputArrayToProcess(0, 1, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::VECTORS);
 }
 

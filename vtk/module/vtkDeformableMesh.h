@@ -39,6 +39,9 @@ class vtkImageData;
  *   vtkDataObject::FIELD_ASSOCIATION_POINTS, name); by default the active
  *   vectors of port 1.
  *
+ * The parameters and their defaults are the ITK filter's (the constructor
+ * reads the defaults from it).
+ *
  * At each iteration every vertex x_i moves by
  *   s F(x_i) + a E_i + b R_i + beta n_i
  * with F the force field sampled by trilinear interpolation (ScaleFactor s),
@@ -125,7 +128,9 @@ public:
   ///@{
   /**
    * Balloon force: displacement along the outward unit normal per iteration,
-   * in physical units; positive inflates, negative deflates. Default: 0.
+   * in physical units; positive inflates, negative deflates. The ITK filter
+   * releases it for a vertex once the external force opposes it at least as
+   * strongly, so that the vertex settles on the edge. Default: 0.
    */
   vtkSetMacro(Balloon, double);
   vtkGetMacro(Balloon, double);
@@ -152,7 +157,7 @@ public:
   ///@{
   /**
    * Number of consecutive iterations below ConvergenceTolerance that declare
-   * convergence. At least 1. Default: 5.
+   * convergence. At least 1. Default: 3.
    */
   vtkSetClampMacro(ConvergenceWindow, int, 1, VTK_INT_MAX);
   vtkGetMacro(ConvergenceWindow, int);
