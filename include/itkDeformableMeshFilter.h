@@ -150,9 +150,11 @@ public:
    * deflates. "Outward" is decided from the signed volume of the mesh, so an
    * inward-oriented closed mesh behaves the same as an outward-oriented one.
    * The balloon carries each vertex to an edge: once the external force
-   * opposes it at least as strongly (the vertex has reached the edge's capture
-   * range), it is released for that vertex until the next reset, so that the
-   * vertex settles on the edge rather than where the two forces balance.
+   * opposes it with at least half its strength (the vertex has reached the
+   * edge's capture range), it is released for that vertex until the next
+   * reset, so that the vertex settles on the edge rather than where the two
+   * forces balance. Half, not any opposing force, so that noise far from the
+   * edge does not stop the inflation.
    * Must be finite. Default: 0. */
   itkSetMacro(Balloon, double);
   itkGetConstMacro(Balloon, double);

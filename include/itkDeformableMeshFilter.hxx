@@ -101,7 +101,7 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareForceSampler()
       indexToPhysical(r, c) = image->GetDirection()(r, c) * image->GetSpacing()[c];
     }
   }
-  const vnl_matrix<double> physicalToIndex = indexToPhysical.GetInverse();
+  const vnl_matrix<double> physicalToIndex = indexToPhysical.GetInverse().as_matrix();
   for (unsigned int r = 0; r < 3; ++r)
   {
     for (unsigned int c = 0; c < 3; ++c)
@@ -489,14 +489,14 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
           }
         }
         // The balloon carries a vertex to an edge, not past it: once the
-        // external force opposes it at least as strongly, the vertex is in the
-        // edge's capture range and the balloon is released for it, so that it
-        // settles on the edge itself instead of where the two forces balance.
+        // external force opposes it with half its strength, the vertex is in
+        // the edge's capture range and the balloon is released for it, so that
+        // it settles on the edge itself instead of where the forces balance.
         double inflation = 0.0;
         if (balloon != 0.0 && !balloonReleased[i])
         {
           const double externalAlongNormal = delta[0] * normal[0] + delta[1] * normal[1] + delta[2] * normal[2];
-          if (balloon * externalAlongNormal <= -balloon * balloon)
+          if (balloon * externalAlongNormal <= -0.5 * balloon * balloon)
           {
             balloonReleased[i] = 1;
           }
