@@ -5,7 +5,10 @@
 set -eu
 cd "$(dirname "$0")/.."
 
-packages="cmake make g++ libinsighttoolkit5-dev libgtest-dev libbenchmark-dev"
+# ITK core, tests and benchmarks; VTK 9.1 with its Python for the VTK module,
+# the edmodel Python package and rendering (xvfb for headless tests).
+packages="cmake make g++ libinsighttoolkit5-dev libgtest-dev libbenchmark-dev
+  libvtk9-dev python3-vtk9 xvfb xauth"
 missing=""
 for p in $packages; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
