@@ -579,8 +579,7 @@ Main(const std::vector<std::string> & args)
   }
   if (i >= args.size())
   {
-    PrintMainHelp(std::cerr);
-    throw Error("no command given: use 'edmodel segment' or 'edmodel demo'");
+    throw Error("no command given: use 'edmodel segment' or 'edmodel demo' (see 'edmodel --help')");
   }
 
   const std::string command = args[i];

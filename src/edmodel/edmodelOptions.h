@@ -58,6 +58,11 @@ constexpr unsigned int SnapshotEvery = 10;
  * sphere starts 12 voxels from the ends of the ellipsoid, beyond the capture
  * range of the plain gradient force at sigma = 1 voxel. */
 constexpr bool DemoGradientVectorFlow = true;
+/** Accuracy the demo must reach to exit with 0: mean and largest distance of
+ * the final mesh to the true ellipsoid, in voxels (half a voxel is where a
+ * binary image places its boundary). */
+constexpr double DemoMeanDistanceLimit = 0.5;
+constexpr double DemoMaximumDistanceLimit = 1.5;
 } // namespace defaults
 
 /** Exit codes. */

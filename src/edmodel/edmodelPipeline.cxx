@@ -18,9 +18,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
-#include <memory>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <unistd.h>
 
@@ -31,10 +31,6 @@ namespace
 
 using ForceFilterType = itk::ExternalForceImageFilter<ImageType, ForceImageType>;
 using DeformFilterType = itk::DeformableMeshFilter<MeshType, ForceImageType>;
-
-/** Accuracy the demo must reach, in voxels, to exit with 0. */
-constexpr double DemoMeanDistanceLimit = 0.5;
-constexpr double DemoMaximumDistanceLimit = 1.5;
 
 std::string
 Format(double value, int precision = 3)
@@ -544,7 +540,7 @@ RunDemo(const DemoOptions & options, const GlobalOptions & global)
   double initialMean = 0.0;
   double initialMaximum = 0.0;
   phantom.MeasureDistance(sphere.GetPointer(), initialMean, initialMaximum);
-  const bool good = mean < DemoMeanDistanceLimit && maximum < DemoMaximumDistanceLimit;
+  const bool good = mean < defaults::DemoMeanDistanceLimit && maximum < defaults::DemoMaximumDistanceLimit;
 
   // The result goes to stdout even with --quiet: it is what the demo is for.
   std::cout << "edmodel demo: sphere -> ellipsoid in " << result.iterations << " iterations"
@@ -553,8 +549,8 @@ RunDemo(const DemoOptions & options, const GlobalOptions & global)
             << Format(initialMaximum) << " voxel\n"
             << "  distance to the true ellipsoid, final mesh:     mean " << Format(mean) << " voxel, max "
             << Format(maximum) << " voxel\n"
-            << "  accuracy " << (good ? "good" : "POOR") << " (limits: mean < " << DemoMeanDistanceLimit
-            << " voxel, max < " << DemoMaximumDistanceLimit << " voxel)\n"
+            << "  accuracy " << (good ? "good" : "POOR") << " (limits: mean < " << defaults::DemoMeanDistanceLimit
+            << " voxel, max < " << defaults::DemoMaximumDistanceLimit << " voxel)\n"
             << "  wrote " << written << "\n"
             << "  same run by hand: edmodel segment --image " << imagePath << " --init-sphere 31,31,31,16"
             << (segment.gradientVectorFlow ? " --gvf" : "") << " --output " << (directory / "mesh.vtk").string()
