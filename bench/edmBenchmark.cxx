@@ -364,7 +364,7 @@ private:
 // ---------------------------------------------------------------------------
 // Our filter: external forces + Elasticity + Rigidity, tangential elasticity.
 void
-BM_EDM_DeformableMesh(benchmark::State & state)
+RunDeformableMesh(benchmark::State & state, bool internalForces)
 {
   const int64_t      requested = state.range(0);
   const auto         threads = static_cast<unsigned int>(state.range(1));
@@ -377,8 +377,8 @@ BM_EDM_DeformableMesh(benchmark::State & state)
   model->SetInput(input);
   model->SetForceImage(MeshForceImage());
   model->SetScaleFactor(0.5);
-  model->SetElasticity(0.3);
-  model->SetRigidity(0.1);
+  model->SetElasticity(internalForces ? 0.3 : 0.0);
+  model->SetRigidity(internalForces ? 0.1 : 0.0);
   model->SetIterateFromZero(false);
   model->SetNumberOfWorkUnits(threads == 1 ? 1 : 4 * threads);
   model->SetNumberOfIterations(1);
@@ -395,6 +395,51 @@ BM_EDM_DeformableMesh(benchmark::State & state)
   state.counters["vertex_it/s"] =
     benchmark::Counter(static_cast<double>(vertices * stepsRun), benchmark::Counter::kIsRate);
   state.SetLabel("steps/update=" + std::to_string(steps));
+}
+
+void
+BM_EDM_DeformableMesh(benchmark::State & state)
+{
+  RunDeformableMesh(state, true);
+}
+
+// External force only: the same work as the VTK probe + warp loop.
+void
+BM_EDM_ExternalOnly(benchmark::State & state)
+{
+  RunDeformableMesh(state, false);
+}
+
+// ---------------------------------------------------------------------------
+// The animation case: one step per Update(), as a render loop raising
+// NumberOfIterations by one; adds the per-update cost (output structure and
+// points) to the step.
+void
+BM_EDM_OneStepPerUpdate(benchmark::State & state)
+{
+  const int64_t    requested = state.range(0);
+  const MeshType * input = ModelMesh(requested);
+  const auto       vertices = static_cast<int64_t>(input->GetNumberOfPoints());
+
+  auto model = ModelType::New();
+  model->SetInput(input);
+  model->SetForceImage(MeshForceImage());
+  model->SetScaleFactor(0.5);
+  model->SetElasticity(0.3);
+  model->SetRigidity(0.1);
+  model->SetIterateFromZero(false);
+  model->SetNumberOfIterations(1);
+  model->Update();
+
+  for (auto _ : state)
+  {
+    model->SetNumberOfIterations(model->GetCurrentIteration() + 1);
+    model->Update();
+  }
+  state.counters["vertices"] = static_cast<double>(vertices);
+  state.counters["vertex_it/s"] =
+    benchmark::Counter(static_cast<double>(vertices * state.iterations()), benchmark::Counter::kIsRate);
+  state.SetLabel("default threads");
 }
 
 // ---------------------------------------------------------------------------
@@ -602,6 +647,18 @@ BM_VTK_ProbeWarp(benchmark::State & state)
   state.counters["vertices"] = static_cast<double>(vertices);
   state.counters["vertex_it/s"] =
     benchmark::Counter(static_cast<double>(vertices * stepsRun), benchmark::Counter::kIsRate);
+  // Sanity check that the loop ran: mean distance moved from the initial sphere.
+  double      moved = 0.0;
+  vtkPoints * final = mesh->GetPoints();
+  for (vtkIdType i = 0; i < vertices; ++i)
+  {
+    double p[3];
+    final->GetPoint(i, p);
+    moved += std::sqrt((p[0] - sphere.points[3 * i]) * (p[0] - sphere.points[3 * i]) +
+                       (p[1] - sphere.points[3 * i + 1]) * (p[1] - sphere.points[3 * i + 1]) +
+                       (p[2] - sphere.points[3 * i + 2]) * (p[2] - sphere.points[3 * i + 2]));
+  }
+  state.counters["moved"] = moved / static_cast<double>(vertices);
   state.SetLabel("external force only");
 }
 #endif
@@ -728,6 +785,13 @@ MeshArguments(benchmark::internal::Benchmark * b, bool threaded)
 }
 
 BENCHMARK(BM_EDM_DeformableMesh)->Apply([](benchmark::internal::Benchmark * b) { MeshArguments(b, true); });
+BENCHMARK(BM_EDM_ExternalOnly)->Apply([](benchmark::internal::Benchmark * b) { MeshArguments(b, true); });
+BENCHMARK(BM_EDM_OneStepPerUpdate)
+  ->Arg(100000)
+  ->Arg(1000000)
+  ->ArgName("vertices")
+  ->UseRealTime()
+  ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ITK_DeformableSimplexMesh3D)->Apply([](benchmark::internal::Benchmark * b) { MeshArguments(b, false); });
 #ifdef EDM_BENCHMARK_WITH_VTK
 BENCHMARK(BM_VTK_ProbeWarp)->Apply([](benchmark::internal::Benchmark * b) { MeshArguments(b, true); });
@@ -799,23 +863,26 @@ PrintSummary()
     const double      simplex = Rate("BM_ITK_DeformableSimplexMesh3D" + suffix + "/threads:1/real_time");
     const double      vtk1 = Rate("BM_VTK_ProbeWarp" + suffix + "/threads:1/real_time");
     const double      vtk2 = Rate("BM_VTK_ProbeWarp" + suffix + "/threads:2/real_time");
-    if (ours1 + ours2 + simplex + vtk1 + vtk2 == 0.0)
+    const double      external2 = Rate("BM_EDM_ExternalOnly" + suffix + "/threads:2/real_time");
+    if (ours1 + ours2 + simplex + vtk1 + vtk2 + external2 == 0.0)
     {
       continue;
     }
     std::printf("%s vertices: vertex-iterations/s  EDM 1 thread %.2f M, 2 threads %.2f M; ITK simplex %.2f M; "
-                "VTK probe+warp 1 thread %.2f M, 2 threads %.2f M\n",
+                "VTK probe+warp 1 thread %.2f M, 2 threads %.2f M; EDM external only, 2 threads %.2f M\n",
                 size,
                 ours1 * 1e-6,
                 ours2 * 1e-6,
                 simplex * 1e-6,
                 vtk1 * 1e-6,
-                vtk2 * 1e-6);
+                vtk2 * 1e-6,
+                external2 * 1e-6);
     PrintRatio("EDM 2 threads / 1 thread", ours2, ours1);
     PrintRatio("EDM 2 threads / ITK DeformableSimplexMesh3D", ours2, simplex);
     PrintRatio("EDM 2 threads / VTK probe+warp 2 threads", ours2, vtk2);
     PrintRatio("EDM 1 thread / ITK DeformableSimplexMesh3D", ours1, simplex);
     PrintRatio("EDM 1 thread / VTK probe+warp 1 thread", ours1, vtk1);
+    PrintRatio("EDM external only / VTK probe+warp, 2 threads", external2, vtk2);
   }
   for (const char * size : { "128", "256" })
   {
