@@ -35,8 +35,17 @@ endif()
 # rendering examples. AUTO builds them when find_package(VTK) succeeds.
 set(EDM_USE_VTK AUTO CACHE STRING "Build the VTK module and Python wrapping: AUTO (when VTK is found), ON, OFF")
 set_property(CACHE EDM_USE_VTK PROPERTY STRINGS AUTO ON OFF)
+# The ParaView plugin (paraview/) builds the VTK module against ParaView's VTK.
+option(BUILD_PARAVIEW_PLUGIN "Build the ParaView plugin (paraview/): VTK from ParaView, needs paraview-dev" OFF)
+if(BUILD_PARAVIEW_PLUGIN)
+  set(EDM_USE_VTK ON CACHE STRING "Build the VTK module and Python wrapping: AUTO (when VTK is found), ON, OFF" FORCE)
+  set(EDM_VTK_FROM_PARAVIEW ON CACHE BOOL "Take VTK from an installed ParaView instead of a plain VTK" FORCE)
+endif()
 if(NOT EDM_USE_VTK STREQUAL "OFF")
   add_subdirectory(vtk)
+endif()
+if(BUILD_PARAVIEW_PLUGIN)
+  add_subdirectory(paraview)
 endif()
 
 # Benchmarks (bench/, Google Benchmark): on by default when benchmark is found.
