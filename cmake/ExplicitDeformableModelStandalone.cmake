@@ -20,9 +20,6 @@ install(DIRECTORY include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/ExplicitDefor
 
 set(CMAKE_RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/bin)
 
-if(EXISTS ${PROJECT_SOURCE_DIR}/src/CMakeLists.txt)
-  add_subdirectory(src)
-endif()
 if(BUILD_TESTING)
   add_subdirectory(test)
 endif()
@@ -43,6 +40,10 @@ if(BUILD_PARAVIEW_PLUGIN)
 endif()
 if(NOT EDM_USE_VTK STREQUAL "OFF")
   add_subdirectory(vtk)
+endif()
+# edmodel (src/) after vtk/: it uses the VTK module and edmRendering when built.
+if(EXISTS ${PROJECT_SOURCE_DIR}/src/CMakeLists.txt)
+  add_subdirectory(src)
 endif()
 if(BUILD_PARAVIEW_PLUGIN)
   add_subdirectory(paraview)

@@ -578,3 +578,28 @@ SnapshotSeries::GetNumberOfFiles() const
 }
 } // namespace edm
 #endif
+
+#ifndef EDM_HAVE_VTK_RENDERING
+namespace edm
+{
+struct FigureOne::Internals
+{};
+FigureOne::FigureOne()
+  : m_Internals(nullptr)
+{}
+FigureOne::~FigureOne() = default;
+std::string
+FigureOne::WhyUnavailable()
+{
+  return "this edmodel was built without VTK rendering";
+}
+void
+FigureOne::Add(const MeshType *, itk::SizeValueType)
+{}
+void
+FigureOne::Write(const ImageType *, const MeshType *, itk::SizeValueType, const std::string & path)
+{
+  throw Error("cannot write '" + path + "': " + WhyUnavailable());
+}
+} // namespace edm
+#endif

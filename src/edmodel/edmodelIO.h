@@ -114,6 +114,38 @@ private:
   Internals * m_Internals;
 };
 
+/** The seed's Figure 1, written by edmodel demo: the mesh over the middle
+ * slice of the image (across y) at iterations 0, 10, 50 and the last, in one
+ * PNG rendered offscreen by edm::WriteFigurePNG (vtk/rendering). Needs a build
+ * with VTK rendering (edmodelFigure.cxx). */
+class FigureOne
+{
+public:
+  FigureOne();
+  ~FigureOne();
+  FigureOne(const FigureOne &) = delete;
+  FigureOne &
+  operator=(const FigureOne &) = delete;
+
+  /** Empty when the figure can be rendered here; otherwise why not (no VTK
+   * rendering in this build, or no X display for a VTK that needs one). */
+  static std::string
+  WhyUnavailable();
+
+  /** Keeps a copy of \a mesh when \a iteration is one the figure shows. */
+  void
+  Add(const MeshType * mesh, itk::SizeValueType iteration);
+
+  /** Writes the figure of the meshes kept and \a last to \a path, through
+   * AtomicOutput. Throws Error when it cannot be rendered or written. */
+  void
+  Write(const ImageType * image, const MeshType * last, itk::SizeValueType lastIteration, const std::string & path);
+
+private:
+  struct Internals;
+  Internals * m_Internals;
+};
+
 /** "a.b.c" -> ".c", "a.nii.gz" -> ".nii.gz", lower case. */
 std::string
 GetExtension(const std::string & path);

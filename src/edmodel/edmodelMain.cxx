@@ -234,21 +234,21 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                 "",
                 "keep the raw force field (intensity / mm^2) instead of dividing it by its largest length; --scale "
                 "is then no longer in mm (consider --max-step)",
-                "normalised",
+                GetCoreDefaults().NormalizeForces ? "normalised" : "raw",
                 [&o](const std::string &) { o.normalizeForces = false; } });
   t.push_back({ force,
                 "--gvf",
                 "",
                 "diffuse the force by gradient vector flow (Xu and Prince): larger capture range, reaches into "
                 "concavities",
-                "off",
+                GetCoreDefaults().GradientVectorFlow ? "on" : "off",
                 [&o](const std::string &) { o.gradientVectorFlow = true; } });
   t.push_back({ force,
                 "--gvf-mu",
                 "MU",
                 "regularisation weight of gradient vector flow (dimensionless, > 0): larger is smoother and reaches "
                 "farther",
-                FormatNumber(defaults::GradientVectorFlowRegularization),
+                FormatNumber(GetCoreDefaults().GradientVectorFlowRegularization),
                 [&o](const std::string & s) {
                   o.gradientVectorFlowRegularization = ParseDouble("--gvf-mu", s);
                   if (!(o.gradientVectorFlowRegularization > 0.0))
@@ -261,7 +261,7 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
       "--gvf-iterations",
       "N",
       "diffusion iterations of gradient vector flow (the field spreads as the square root of N)",
-      std::to_string(defaults::GradientVectorFlowIterations),
+      std::to_string(GetCoreDefaults().GradientVectorFlowIterations),
       [&o](const std::string & s) { o.gradientVectorFlowIterations = ParseUnsigned("--gvf-iterations", s); } });
 
   const std::string model = "Deformable model (DeformableMeshFilter)";
@@ -290,7 +290,7 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                 "",
                 "use the full umbrella operator (Laplacian smoothing, shrinks convex surfaces) instead of its "
                 "component tangent to the surface",
-                "tangential",
+                GetCoreDefaults().TangentialElasticity ? "tangential" : "full umbrella",
                 [&o](const std::string &) { o.tangentialElasticity = false; } });
   t.push_back({ model,
                 "--rigidity",
@@ -306,13 +306,13 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                 "--balloon",
                 "MM",
                 "inflation along the outward normal per iteration, physical units (mm); negative deflates",
-                FormatNumber(defaults::Balloon),
+                FormatNumber(GetCoreDefaults().Balloon),
                 [&o](const std::string & s) { o.balloon = ParseDouble("--balloon", s); } });
   t.push_back({ model,
                 "--max-step",
                 "MM",
                 "upper bound on a vertex's displacement per iteration, physical units (mm); 0 means no bound",
-                FormatNumber(defaults::MaximumStepLength),
+                FormatNumber(GetCoreDefaults().MaximumStepLength),
                 [&o](const std::string & s) {
                   o.maximumStepLength = ParseDouble("--max-step", s);
                   RequireAtLeast("--max-step", o.maximumStepLength, 0.0);
@@ -337,7 +337,7 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                 "--window",
                 "N",
                 "consecutive quiet iterations that declare convergence, at least 1",
-                std::to_string(defaults::ConvergenceWindow),
+                std::to_string(GetCoreDefaults().ConvergenceWindow),
                 [&o](const std::string & s) {
                   o.convergenceWindow = ParseUnsigned("--window", s);
                   RequireAtLeast("--window", o.convergenceWindow, 1);
@@ -353,7 +353,7 @@ MakeDemoOptions(DemoOptions & o, GlobalOptions & global)
   t.push_back({ "Options",
                 "--output-dir",
                 "DIR",
-                "directory for the image, the force field and the meshes (created if needed)",
+                "directory for the image, the force field, the meshes, the series and the figure (created if needed)",
                 o.outputDirectory,
                 [&o](const std::string & s) { o.outputDirectory = s; } });
   AddGlobalOptions(t, global, "Options");
@@ -469,11 +469,13 @@ PrintDemoHelp(std::ostream & os, const OptionTable & table)
         "\n"
         "The seed paper's example end to end: a 64^3 binary image of an ellipsoid of radii (18, 14, 28)\n"
         "voxels centred at (31, 31, 31), a sphere of radius 16 at the centre deformed onto it with the\n"
-        "default segment parameters plus gradient vector flow (--gvf). Writes the image (demo-image.nii.gz), the force "
-        "field\n"
-        "(demo-force.mha), the initial and final meshes (demo-sphere.vtk, demo-mesh.vtk), and prints the\n"
-        "mean and largest distance of the final mesh to the true ellipsoid. Exits with 1 when that\n"
-        "accuracy is poor.\n";
+        "default segment parameters plus gradient vector flow (--gvf). Writes the image (demo-image.nii.gz),\n"
+        "the force field (demo-force.mha), the initial and final meshes (demo-sphere.vtk, demo-mesh.vtk)\n"
+        "and, when built with VTK, the time series (series/demo.pvd, every 10 iterations) and the seed's\n"
+        "Figure 1 (demo-figure1.png: the mesh over the middle slice of the image at iterations 0, 10, 50\n"
+        "and the last; Debian's VTK renders through X, so without a display the figure is skipped with a\n"
+        "message: run under xvfb-run -a). Prints the mean and largest distance of the final mesh to the\n"
+        "true ellipsoid, and exits with 1 when that accuracy is poor.\n";
   PrintOptions(os, table);
 }
 

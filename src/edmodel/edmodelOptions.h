@@ -27,8 +27,27 @@
 namespace edm
 {
 
-/** Every default of the command line, in one place. Lengths are in physical
- * units (mm for medical images). */
+/** The defaults the command line shares with the core filters, read from a
+ * default-constructed itk::ExternalForceImageFilter and
+ * itk::DeformableMeshFilter (edmodelPipeline.cxx): the core stays their
+ * single source of truth. */
+struct CoreDefaults
+{
+  bool         NormalizeForces;
+  bool         GradientVectorFlow;
+  double       GradientVectorFlowRegularization;
+  unsigned int GradientVectorFlowIterations;
+  bool         TangentialElasticity;
+  double       Balloon;
+  double       MaximumStepLength;
+  unsigned int ConvergenceWindow;
+};
+const CoreDefaults &
+GetCoreDefaults();
+
+/** The defaults of the command line that differ from the core's (the core's
+ * are neutral: no elasticity, no iteration, no convergence test) or have no
+ * counterpart there. Lengths are in physical units (mm for medical images). */
 namespace defaults
 {
 /** Gaussian smoothing of the force field, in voxels of the smallest spacing
@@ -37,17 +56,9 @@ constexpr double SigmaInVoxels = 1.0;
 /** Largest external displacement per iteration, as a fraction of Sigma. */
 constexpr double       ScaleOverSigma = 0.5;
 constexpr double       Elasticity = 0.3;
-constexpr bool         TangentialElasticity = true;
 constexpr double       Rigidity = 0.05;
-constexpr double       Balloon = 0.0;
-constexpr double       MaximumStepLength = 0.0;
 constexpr unsigned int Iterations = 500;
 constexpr double       ConvergenceTolerance = 0.01;
-constexpr unsigned int ConvergenceWindow = 3;
-constexpr bool         NormalizeForces = true;
-constexpr bool         GradientVectorFlow = false;
-constexpr double       GradientVectorFlowRegularization = 0.1;
-constexpr unsigned int GradientVectorFlowIterations = 400;
 /** Subdivisions of the octahedron of --init-sphere (4 * 4^n + 2 points). */
 constexpr unsigned int SphereResolution = 4;
 /** Radius of the default initial sphere, as a fraction of the smallest
@@ -108,19 +119,19 @@ struct SegmentOptions
 
   double       sigma{ -1.0 }; // negative: defaults::SigmaInVoxels times the smallest spacing
   double       scale{ -1.0 }; // negative: defaults::ScaleOverSigma times sigma
-  bool         normalizeForces{ defaults::NormalizeForces };
-  bool         gradientVectorFlow{ defaults::GradientVectorFlow };
-  double       gradientVectorFlowRegularization{ defaults::GradientVectorFlowRegularization };
-  unsigned int gradientVectorFlowIterations{ defaults::GradientVectorFlowIterations };
+  bool         normalizeForces{ GetCoreDefaults().NormalizeForces };
+  bool         gradientVectorFlow{ GetCoreDefaults().GradientVectorFlow };
+  double       gradientVectorFlowRegularization{ GetCoreDefaults().GradientVectorFlowRegularization };
+  unsigned int gradientVectorFlowIterations{ GetCoreDefaults().GradientVectorFlowIterations };
 
   double       elasticity{ defaults::Elasticity };
-  bool         tangentialElasticity{ defaults::TangentialElasticity };
+  bool         tangentialElasticity{ GetCoreDefaults().TangentialElasticity };
   double       rigidity{ defaults::Rigidity };
-  double       balloon{ defaults::Balloon };
-  double       maximumStepLength{ defaults::MaximumStepLength };
+  double       balloon{ GetCoreDefaults().Balloon };
+  double       maximumStepLength{ GetCoreDefaults().MaximumStepLength };
   unsigned int iterations{ defaults::Iterations };
   double       convergenceTolerance{ defaults::ConvergenceTolerance };
-  unsigned int convergenceWindow{ defaults::ConvergenceWindow };
+  unsigned int convergenceWindow{ GetCoreDefaults().ConvergenceWindow };
   unsigned int snapshotEvery{ defaults::SnapshotEvery };
   bool         snapshotEverySet{ false };
 };

@@ -372,6 +372,28 @@ SetNumberOfThreads(unsigned int threads)
   }
 }
 
+const CoreDefaults &
+GetCoreDefaults()
+{
+  // Read once from default-constructed filters: the core is the single source
+  // of truth for these defaults.
+  static const CoreDefaults defaults = []() {
+    const auto   force = ForceFilterType::New();
+    const auto   deform = DeformFilterType::New();
+    CoreDefaults d;
+    d.NormalizeForces = force->GetNormalizeForces();
+    d.GradientVectorFlow = force->GetUseGradientVectorFlow();
+    d.GradientVectorFlowRegularization = force->GetGradientVectorFlowRegularization();
+    d.GradientVectorFlowIterations = force->GetGradientVectorFlowIterations();
+    d.TangentialElasticity = deform->GetTangentialElasticity();
+    d.Balloon = deform->GetBalloon();
+    d.MaximumStepLength = deform->GetMaximumStepLength();
+    d.ConvergenceWindow = deform->GetConvergenceWindow();
+    return d;
+  }();
+  return defaults;
+}
+
 bool
 HasVTK()
 {
@@ -484,6 +506,7 @@ RunDemo(const DemoOptions & options, const GlobalOptions & global)
   const auto     forcePath = (directory / "demo-force.mha").string();
   const auto     spherePath = (directory / "demo-sphere.vtk").string();
   const auto     meshPath = (directory / "demo-mesh.vtk").string();
+  const auto     figurePath = (directory / "demo-figure1.png").string();
 
   // The seed's example: a 64^3 binary ellipsoid and a sphere at its centre.
   const double                      centerValues[3] = { 31.0, 31.0, 31.0 };
@@ -515,11 +538,31 @@ RunDemo(const DemoOptions & options, const GlobalOptions & global)
   progress.Note("demo: 64^3 binary ellipsoid of radii (18, 14, 28) voxels centred at (31, 31, 31); sphere of radius " +
                 Format(sphereRadius) + " at the centre, " + std::to_string(sphere->GetNumberOfPoints()) + " points");
   std::unique_ptr<SnapshotSeries> series;
-  SnapshotCallback                snapshot;
 #ifdef EDM_HAVE_VTK
   series = std::make_unique<SnapshotSeries>((directory / "series").string(), "demo");
-  snapshot = [&series](const MeshType * mesh, itk::SizeValueType iteration) { series->Add(mesh, iteration); };
 #endif
+  // Figure 1 (with VTK rendering and a display, or a VTK that needs none).
+  const std::string          noFigure = FigureOne::WhyUnavailable();
+  std::unique_ptr<FigureOne> figure;
+  if (noFigure.empty())
+  {
+    figure = std::make_unique<FigureOne>();
+  }
+  SnapshotCallback snapshot;
+  if (series || figure)
+  {
+    segment.snapshotEvery = 10; // Figure 1 shows iterations 10 and 50.
+    snapshot = [&series, &figure](const MeshType * mesh, itk::SizeValueType iteration) {
+      if (series)
+      {
+        series->Add(mesh, iteration);
+      }
+      if (figure)
+      {
+        figure->Add(mesh, iteration);
+      }
+    };
+  }
   const DeformResult result = Deform(image, sphere, segment, progress, snapshot);
 
   WriteImage(image, imagePath);
@@ -532,6 +575,11 @@ RunDemo(const DemoOptions & options, const GlobalOptions & global)
     series->Commit();
     written += ", " + series->GetCollectionPath() + " (" + std::to_string(series->GetNumberOfFiles()) +
                " snapshots, open it in ParaView)";
+  }
+  if (figure)
+  {
+    figure->Write(image, result.mesh, result.iterations, figurePath);
+    written += ", " + figurePath + " (Figure 1)";
   }
 
   double mean = 0.0;
@@ -552,6 +600,7 @@ RunDemo(const DemoOptions & options, const GlobalOptions & global)
             << "  accuracy " << (good ? "good" : "POOR") << " (limits: mean < " << defaults::DemoMeanDistanceLimit
             << " voxel, max < " << defaults::DemoMaximumDistanceLimit << " voxel)\n"
             << "  wrote " << written << "\n"
+            << (figure ? std::string() : "  skipped " + figurePath + " (Figure 1): " + noFigure + "\n")
             << "  same run by hand: edmodel segment --image " << imagePath << " --init-sphere 31,31,31,16"
             << (segment.gradientVectorFlow ? " --gvf" : "") << " --output " << (directory / "mesh.vtk").string()
             << "\n";

@@ -30,8 +30,10 @@
 //   iteration per frame up to N (IterateFromZero off), then the window stays
 //   open for inspection (or closes with --exit-when-done);
 // - otherwise: Figure 1 offscreen: four views of the mesh (wireframe, and its
-//   cut in red) over the image slice y = 31 at iterations 0, 10, 50 and N (default 200), written to a PNG
-//   (default DeformableMesh.png);
+//   cut in red) over the image slice y = 31 at iterations 0, 10, 50 and N
+//   (default 200), written to a PNG (default DeformableMesh.png); the
+//   composition is edm::WriteFigurePNG (vtk/rendering), shared with edmodel
+//   demo;
 // - with --series: every K-th iteration (default 10) as .vtp plus a .pvd.
 // The program checks the known answer: the mean distance of the final mesh to
 // the true ellipsoid is below 0.5 voxel.
@@ -44,24 +46,13 @@
 #include "itkEllipsoidPhantom.h"
 #include "itkExternalForceImageFilter.h"
 
-#include "vtkActor.h"
 #include "vtkCallbackCommand.h"
-#include "vtkCamera.h"
-#include "vtkCoordinate.h"
-#include "vtkCutter.h"
-#include "vtkImageActor.h"
 #include "vtkImageData.h"
-#include "vtkImageMapper3D.h"
-#include "vtkImageProperty.h"
-#include "vtkPlane.h"
 #include "vtkPolyData.h"
-#include "vtkPolyDataMapper.h"
-#include "vtkProperty.h"
 #include "vtkRenderWindowInteractor.h"
 #include "vtkRenderer.h"
 #include "vtkSphereSource.h"
 #include "vtkTextActor.h"
-#include "vtkTextProperty.h"
 
 #include <array>
 #include <chrono>
@@ -85,69 +76,6 @@ MakeEllipsoid()
   radii[1] = 14.0;
   radii[2] = 28.0;
   return itk::EllipsoidPhantom(center, radii);
-}
-
-/** The slice y = Center of the image, with the mesh's wireframe and its cut
- * by the slice plane, labelled with the iteration. */
-vtkTextActor *
-AddView(vtkRenderer * renderer, vtkImageData * image, vtkPolyData * mesh, int iteration)
-{
-  vtkNew<vtkImageActor> slice;
-  slice->GetMapper()->SetInputData(image);
-  slice->SetDisplayExtent(0, 63, 31, 31, 0, 63);
-  slice->GetProperty()->SetColorWindow(400.0);
-  slice->GetProperty()->SetColorLevel(100.0);
-  renderer->AddViewProp(slice);
-
-  vtkNew<vtkPolyDataMapper> wireMapper;
-  wireMapper->SetInputData(mesh);
-  wireMapper->ScalarVisibilityOff();
-  vtkNew<vtkActor> wire;
-  wire->SetMapper(wireMapper);
-  wire->GetProperty()->SetRepresentationToWireframe();
-  wire->GetProperty()->SetColor(0.3, 0.6, 1.0);
-  wire->GetProperty()->SetOpacity(0.25);
-  wire->GetProperty()->LightingOff(); // Flat colours: lines have no meaningful normals.
-  renderer->AddActor(wire);
-
-  vtkNew<vtkPlane> plane;
-  plane->SetOrigin(Center, 31.0, Center);
-  plane->SetNormal(0.0, 1.0, 0.0);
-  vtkNew<vtkCutter> cutter;
-  cutter->SetInputData(mesh);
-  cutter->SetCutFunction(plane);
-  vtkNew<vtkPolyDataMapper> cutMapper;
-  cutMapper->SetInputConnection(cutter->GetOutputPort());
-  cutMapper->ScalarVisibilityOff();
-  vtkNew<vtkActor> cut;
-  cut->SetMapper(cutMapper);
-  cut->GetProperty()->SetColor(1.0, 0.2, 0.1);
-  cut->GetProperty()->SetLineWidth(3.0);
-  cut->GetProperty()->LightingOff();
-  // In front of everything: the parallel projection along y does not show
-  // the shift.
-  cut->SetPosition(0.0, -64.0, 0.0);
-  renderer->AddActor(cut);
-
-  vtkNew<vtkTextActor> label;
-  label->SetInput(("iteration " + std::to_string(iteration)).c_str());
-  label->GetTextProperty()->SetFontSize(22);
-  label->GetTextProperty()->SetColor(1.0, 1.0, 1.0);
-  label->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
-  label->SetPosition(0.03, 0.03);
-  renderer->AddActor2D(label);
-
-  renderer->SetBackground(0.1, 0.1, 0.2);
-  vtkCamera * camera = renderer->GetActiveCamera();
-  // Looking along +y at the slice, z up: the cut of the mesh (red) over the
-  // ellipse of the image, the mesh's wireframe (blue) for its shape.
-  camera->ParallelProjectionOn();
-  camera->SetFocalPoint(Center, Center, Center);
-  camera->SetPosition(Center, Center - 200.0, Center);
-  camera->SetViewUp(0.0, 0.0, 1.0);
-  renderer->ResetCamera();
-  camera->SetParallelScale(34.0);
-  return label;
 }
 
 struct Animation
@@ -242,14 +170,14 @@ main(int argc, char * argv[])
   deformable->SetElasticity(0.2);
   deformable->IterateFromZeroOff();
 
-  vtkNew<vtkRenderWindow> window;
-  window->SetWindowName("DeformableMesh");
   if (interactive)
   {
+    vtkNew<vtkRenderWindow> window;
+    window->SetWindowName("DeformableMesh");
     deformable->SetNumberOfIterations(0);
     deformable->Update();
     vtkNew<vtkRenderer> renderer;
-    vtkTextActor *      label = AddView(renderer, intensity, deformable->GetOutput(), 0);
+    vtkTextActor *      label = edm::AddFigureView(renderer, intensity, deformable->GetOutput(), 0);
     window->AddRenderer(renderer);
     window->SetSize(700, 700);
     vtkNew<vtkRenderWindowInteractor> interactor;
@@ -306,27 +234,25 @@ main(int argc, char * argv[])
     std::cout << "Wrote " << writer->GetNumberOfWrittenFiles() << " iterations and " << series << std::endl;
   }
 
-  if (!HasDisplay() && !CanRenderWithoutDisplay(window))
+  const std::string whyNot = edm::WhyNoOffscreenRendering();
+  if (!whyNot.empty())
   {
-    std::cerr << "No display, and this VTK renders through X only: run under xvfb-run." << std::endl;
+    std::cerr << "No Figure 1: " << whyNot << "." << std::endl;
     return SkipExitCode;
   }
-  window->SetOffScreenRendering(1);
-  window->SetSize(1000, 1000);
-  const double viewports[4][4] = {
-    { 0.0, 0.5, 0.5, 1.0 }, { 0.5, 0.5, 1.0, 1.0 }, { 0.0, 0.0, 0.5, 0.5 }, { 0.5, 0.0, 1.0, 0.5 }
-  };
-  for (int k = 0; k < 4; ++k)
+  const std::string          fileName = png.empty() ? "DeformableMesh.png" : png;
+  std::vector<vtkPolyData *> views;
+  for (const auto & mesh : meshes)
   {
-    vtkNew<vtkRenderer> renderer;
-    renderer->SetViewport(viewports[k]);
-    AddView(renderer, intensity, meshes[k], snapshots[k]);
-    window->AddRenderer(renderer);
+    views.push_back(mesh);
   }
-  if (!WritePNG(window, png.empty() ? "DeformableMesh.png" : png))
+  std::string error;
+  if (!edm::WriteFigurePNG(intensity, views, std::vector<int>(snapshots.begin(), snapshots.end()), fileName, error))
   {
+    std::cerr << "No Figure 1: " << error << std::endl;
     return EXIT_FAILURE;
   }
+  std::cout << "Wrote " << fileName << std::endl;
 
   if (!(finalDistance < 0.5))
   {

@@ -168,9 +168,10 @@ main(int argc, char * argv[])
     return requested == 0 || warp->GetCurrentIteration() == requested ? EXIT_SUCCESS : EXIT_FAILURE;
   }
 
-  if (!HasDisplay() && !CanRenderWithoutDisplay(window))
+  const std::string whyNot = edm::WhyNoOffscreenRendering();
+  if (!whyNot.empty())
   {
-    std::cerr << "No display, and this VTK renders through X only: run under xvfb-run." << std::endl;
+    std::cerr << "No PNG: " << whyNot << "." << std::endl;
     return SkipExitCode;
   }
   window->SetOffScreenRendering(1);

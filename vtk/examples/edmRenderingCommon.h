@@ -18,15 +18,14 @@
 #ifndef edmRenderingCommon_h
 #define edmRenderingCommon_h
 
-// Small helpers shared by the rendering examples: command line, display
-// detection, PNG output.
+// Small helpers shared by the rendering examples: command line, and display
+// detection and PNG output from edmRendering (vtk/rendering).
+
+#include "edmRendering.h"
 
 #include "vtkNew.h"
-#include "vtkPNGWriter.h"
 #include "vtkRenderWindow.h"
-#include "vtkWindowToImageFilter.h"
 
-#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
@@ -67,39 +66,15 @@ HasFlag(int argc, char * argv[], const char * name)
   return false;
 }
 
-/** True when an X display is available. */
-inline bool
-HasDisplay()
-{
-  const char * display = std::getenv("DISPLAY");
-  return display != nullptr && display[0] != '\0';
-}
+using edm::CanRenderWithoutDisplay;
+using edm::HasDisplay;
 
-/** Whether this VTK can render without a display (EGL or OSMesa builds);
- * Debian's VTK renders through X only, offscreen included. */
-inline bool
-CanRenderWithoutDisplay(vtkRenderWindow * window)
-{
-  const std::string name = window->GetClassName();
-  return name != "vtkXOpenGLRenderWindow";
-}
-
-/** Renders \a window and writes it as a PNG file; false on failure. */
+/** Renders \a window and writes it as a PNG file, with a message; false on
+ * failure. */
 inline bool
 WritePNG(vtkRenderWindow * window, const std::string & fileName)
 {
-  std::remove(fileName.c_str()); // No stale image left behind on failure.
-  window->Render();
-  vtkNew<vtkWindowToImageFilter> grab;
-  grab->SetInput(window);
-  grab->SetInputBufferTypeToRGB();
-  grab->ReadFrontBufferOff();
-  grab->Update();
-  vtkNew<vtkPNGWriter> writer;
-  writer->SetFileName(fileName.c_str());
-  writer->SetInputConnection(grab->GetOutputPort());
-  writer->Write();
-  if (writer->GetErrorCode() != 0)
+  if (!edm::WriteRenderWindowPNG(window, fileName))
   {
     std::cerr << "Cannot write " << fileName << std::endl;
     return false;
