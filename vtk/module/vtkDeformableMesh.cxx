@@ -80,7 +80,10 @@ vtkDeformableMesh::vtkDeformableMesh()
 //------------------------------------------------------------------------------
 vtkDeformableMesh::~vtkDeformableMesh()
 {
-  delete this->DeformableInternals;
+  if (!edmProcessIsExiting())
+  {
+    delete this->DeformableInternals;
+  }
 }
 
 //------------------------------------------------------------------------------

@@ -32,6 +32,22 @@
 #include "vtkPolyData.h"
 
 #include <algorithm>
+#include <atomic>
+
+namespace
+{
+std::atomic<bool> processIsExiting{ false };
+struct ExitFlag
+{
+  ~ExitFlag() { processIsExiting = true; }
+} exitFlag;
+} // namespace
+
+bool
+edmProcessIsExiting()
+{
+  return processIsExiting;
+}
 
 //------------------------------------------------------------------------------
 vtkIterativePolyDataAlgorithm::vtkIterativePolyDataAlgorithm()
@@ -41,7 +57,10 @@ vtkIterativePolyDataAlgorithm::vtkIterativePolyDataAlgorithm()
 //------------------------------------------------------------------------------
 vtkIterativePolyDataAlgorithm::~vtkIterativePolyDataAlgorithm()
 {
-  delete this->Internals;
+  if (!edmProcessIsExiting())
+  {
+    delete this->Internals;
+  }
 }
 
 //------------------------------------------------------------------------------

@@ -26,6 +26,18 @@
 class vtkPolyData;
 
 /**
+ * True once the process has begun to exit (static destruction). ParaView's
+ * pvpython destroys its proxies, and with them our VTK objects, from a static
+ * of a library loaded before this module, hence after ITK's globals (time
+ * stamp, singletons) are gone: destroying an ITK object then crashes. A static
+ * of this module, destroyed before the statics of the libraries loaded before
+ * it (ParaView's), sets the flag; the destructors then leave the ITK objects
+ * to the operating system.
+ */
+bool
+edmProcessIsExiting();
+
+/**
  * The ITK side of a vtkIterativePolyDataAlgorithm (private header): the mesh
  * type the VTK classes compute with, the ITK filter of the subclass, and the
  * ITK mesh converted from the VTK input, kept while the input does not change
