@@ -77,7 +77,9 @@ WritePolyDataMesh(const MeshType * mesh, const std::string & path)
     vtkNew<vtkXMLPolyDataWriter> writer;
     writer->SetInputData(polyData);
     writer->SetFileName(path.c_str());
-    writer->SetDataModeToAppended();
+    // Inline binary, not appended: Debian's ParaView 5.11 cannot read appended
+    // data with the current expat (VTK issue 19258, expat reparse deferral).
+    writer->SetDataModeToBinary();
     writer->SetCompressorTypeToZLib();
     written = writer->Write();
   }

@@ -159,7 +159,9 @@ vtkIterationSeriesWriter::WriteIteration(vtkPolyData * mesh, int iteration)
   writer->SetInputData(mesh);
   if (this->Binary)
   {
-    writer->SetDataModeToAppended();
+    // Inline binary, not appended: Debian's ParaView 5.11 cannot read appended
+    // data with the current expat (VTK issue 19258, expat reparse deferral).
+    writer->SetDataModeToBinary();
   }
   else
   {
