@@ -269,7 +269,8 @@ private:
   std::vector<IndexType32> m_Neighbours;
   std::vector<IndexType32> m_Triangles;
   std::vector<IndexType32> m_VertexTriangleOffsets;
-  std::vector<IndexType32> m_VertexTriangles;
+  std::vector<IndexType32> m_VertexTriangles; // pairs (b, c): the edge opposite the vertex
+  SizeValueType            m_NumberOfTriangles{ 0 };
 
   // Per-vertex state.
   std::vector<double>  m_NextCoordinates;

@@ -260,7 +260,9 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology()
     }
   }
 
-  // CSR vertex-triangle table.
+  // CSR table of the edges opposite each vertex in its triangles, oriented as
+  // the triangles: the normal of vertex i sums (b - x_i) x (c - x_i) over its
+  // pairs (b, c), with no triangle indirection in the step.
   const SizeValueType numberOfTriangles = m_Triangles.size() / 3;
   m_VertexTriangleOffsets.assign(numberOfPoints + 1, 0);
   for (const IndexType32 v : m_Triangles)
@@ -271,14 +273,16 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology()
   {
     m_VertexTriangleOffsets[i + 1] += m_VertexTriangleOffsets[i];
   }
-  m_VertexTriangles.resize(m_VertexTriangleOffsets[numberOfPoints]);
+  m_VertexTriangles.resize(2 * static_cast<SizeValueType>(m_VertexTriangleOffsets[numberOfPoints]));
   {
     std::vector<IndexType32> fill(m_VertexTriangleOffsets.begin(), m_VertexTriangleOffsets.end() - 1);
     for (SizeValueType t = 0; t < numberOfTriangles; ++t)
     {
       for (unsigned int k = 0; k < 3; ++k)
       {
-        m_VertexTriangles[fill[m_Triangles[3 * t + k]]++] = static_cast<IndexType32>(t);
+        IndexType32 * pair = m_VertexTriangles.data() + 2 * static_cast<SizeValueType>(fill[m_Triangles[3 * t + k]]++);
+        pair[0] = m_Triangles[3 * t + (k + 1) % 3];
+        pair[1] = m_Triangles[3 * t + (k + 2) % 3];
       }
     }
   }
@@ -295,6 +299,8 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology()
       a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
   }
   m_OrientationSign = volume < 0.0 ? -1.0 : 1.0;
+  m_NumberOfTriangles = numberOfTriangles;
+  std::vector<IndexType32>().swap(m_Triangles); // only the opposite edges are needed from here on
 }
 
 template <typename TMesh, typename TForceImage>
@@ -321,12 +327,11 @@ DeformableMeshFilter<TMesh, TForceImage>::ComputeNormal(const double * x, SizeVa
   double n[3] = { 0.0, 0.0, 0.0 };
   for (IndexType32 k = m_VertexTriangleOffsets[i]; k < m_VertexTriangleOffsets[i + 1]; ++k)
   {
-    const IndexType32 * t = m_Triangles.data() + 3 * m_VertexTriangles[k];
-    const double *      a = x + 3 * t[0];
-    const double *      b = x + 3 * t[1];
-    const double *      c = x + 3 * t[2];
-    const double        u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
-    const double        v[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+    const double * a = x + 3 * i;
+    const double * b = x + 3 * m_VertexTriangles[2 * k];
+    const double * c = x + 3 * m_VertexTriangles[2 * k + 1];
+    const double   u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+    const double   v[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
     n[0] += u[1] * v[2] - u[2] * v[1];
     n[1] += u[2] * v[0] - u[0] * v[2];
     n[2] += u[0] * v[1] - u[1] * v[0];
@@ -565,8 +570,7 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "QuietIterations: " << m_QuietIterations << std::endl;
   os << indent << "LastMaximumDisplacement: " << m_LastMaximumDisplacement << std::endl;
   os << indent << "OrientationSign: " << m_OrientationSign << std::endl;
-  os << indent << "Neighbours: " << m_Neighbours.size() << " entries, Triangles: " << m_Triangles.size() / 3
-     << std::endl;
+  os << indent << "Neighbours: " << m_Neighbours.size() << " entries, Triangles: " << m_NumberOfTriangles << std::endl;
   os << indent << "ForceBuffer: " << m_ForceBuffer << std::endl;
   os << indent << "PhysicalToIndex: [" << m_PhysicalToIndex[0][0] << ' ' << m_PhysicalToIndex[0][1] << ' '
      << m_PhysicalToIndex[0][2] << "; " << m_PhysicalToIndex[1][0] << ' ' << m_PhysicalToIndex[1][1] << ' '

@@ -20,7 +20,6 @@
 
 #include "itkExternalForceImageFilter.h"
 #include "itkCastImageFilter.h"
-#include "itkGradientMagnitudeImageFilter.h"
 #include "itkImageAlgorithm.h"
 #include "itkMultiThreaderBase.h"
 #include "itkProgressAccumulator.h"
@@ -112,15 +111,20 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::GenerateData()
   }
   smoothed->DisconnectPipeline();
 
-  using MagnitudeType = GradientMagnitudeImageFilter<RealImageType, RealImageType>;
-  auto magnitude = MagnitudeType::New();
-  magnitude->SetInput(smoothed);
-  magnitude->SetUseImageSpacing(this->GetUseImageSpacing());
-  magnitude->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
-  progress->RegisterInternalFilter(magnitude, 0.2f);
-  magnitude->Update();
-  typename RealImageType::Pointer edgeMap = magnitude->GetOutput();
-  edgeMap->DisconnectPipeline();
+  // Edge map |grad (G * I)|.
+  auto edgeMap = RealImageType::New();
+  edgeMap->CopyInformation(smoothed);
+  edgeMap->SetRegions(smoothed->GetBufferedRegion());
+  edgeMap->Allocate();
+  float * edges = edgeMap->GetBufferPointer();
+  this->ForEachCentralDifference(smoothed, [edges](OffsetValueType i, const double * derivative) {
+    double squaredNorm = 0.0;
+    for (unsigned int d = 0; d < ImageDimension; ++d)
+    {
+      squaredNorm += derivative[d] * derivative[d];
+    }
+    edges[i] = static_cast<float>(std::sqrt(squaredNorm));
+  });
   smoothed = nullptr;
 
   if (m_UseGradientVectorFlow)
@@ -135,16 +139,28 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::GenerateData()
     }
   }
 
-  using ForceGradientType = GradientImageFilter<RealImageType, OutputValueType, OutputValueType, OutputImageType>;
-  auto gradient = ForceGradientType::New();
-  gradient->SetInput(edgeMap);
-  gradient->SetUseImageSpacing(this->GetUseImageSpacing());
-  gradient->SetUseImageDirection(this->GetUseImageDirection());
-  gradient->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
-  progress->RegisterInternalFilter(gradient, 0.2f);
-  gradient->Update();
-  typename OutputImageType::Pointer field = gradient->GetOutput();
-  field->DisconnectPipeline();
+  // Force grad |grad (G * I)|, in physical axes when UseImageDirection is on.
+  auto field = OutputImageType::New();
+  field->CopyInformation(edgeMap);
+  field->SetRegions(edgeMap->GetBufferedRegion());
+  field->Allocate();
+  OutputPixelType * forces = field->GetBufferPointer();
+  const bool        useDirection = this->GetUseImageDirection();
+  const auto        direction = edgeMap->GetDirection();
+  this->ForEachCentralDifference(edgeMap, [=](OffsetValueType i, const double * derivative) {
+    for (unsigned int r = 0; r < ImageDimension; ++r)
+    {
+      double component = useDirection ? 0.0 : derivative[r];
+      if (useDirection)
+      {
+        for (unsigned int c = 0; c < ImageDimension; ++c)
+        {
+          component += direction(r, c) * derivative[c];
+        }
+      }
+      forces[i][r] = static_cast<OutputValueType>(component);
+    }
+  });
 
   if (m_UseGradientVectorFlow)
   {
@@ -170,6 +186,66 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::GenerateData()
     }
   }
   this->GraftOutput(field);
+}
+
+template <typename TInputImage, typename TOutputImage>
+template <typename TFunction>
+void
+ExternalForceImageFilter<TInputImage, TOutputImage>::ForEachCentralDifference(const RealImageType * image,
+                                                                              const TFunction &     function)
+{
+  const auto          region = image->GetBufferedRegion();
+  const auto          size = region.GetSize();
+  const float *       v = image->GetBufferPointer();
+  const SizeValueType lineLength = size[0];
+  const SizeValueType numberOfLines = region.GetNumberOfPixels() / lineLength;
+
+  OffsetValueType stride[ImageDimension];
+  double          scale[ImageDimension];
+  stride[0] = 1;
+  for (unsigned int d = 0; d < ImageDimension; ++d)
+  {
+    if (d > 0)
+    {
+      stride[d] = stride[d - 1] * static_cast<OffsetValueType>(size[d - 1]);
+    }
+    scale[d] = 0.5 / (this->GetUseImageSpacing() ? image->GetSpacing()[d] : 1.0);
+  }
+
+  MultiThreaderBase * threader = this->GetMultiThreader();
+  threader->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
+  threader->ParallelizeArray(
+    0,
+    numberOfLines,
+    [&](SizeValueType line) {
+      // Offsets of the lower and upper neighbours along each axis; zero at the
+      // border (zero-flux Neumann condition, as GradientImageFilter's default).
+      SizeValueType   remainder = line;
+      OffsetValueType lineStart = 0;
+      OffsetValueType lower[ImageDimension];
+      OffsetValueType upper[ImageDimension];
+      for (unsigned int d = 1; d < ImageDimension; ++d)
+      {
+        const SizeValueType coordinate = remainder % size[d];
+        remainder /= size[d];
+        lineStart += static_cast<OffsetValueType>(coordinate) * stride[d];
+        lower[d] = coordinate > 0 ? -stride[d] : 0;
+        upper[d] = coordinate + 1 < size[d] ? stride[d] : 0;
+      }
+      double derivative[ImageDimension];
+      for (SizeValueType x = 0; x < lineLength; ++x)
+      {
+        const OffsetValueType i = lineStart + static_cast<OffsetValueType>(x);
+        lower[0] = x > 0 ? -1 : 0;
+        upper[0] = x + 1 < lineLength ? 1 : 0;
+        for (unsigned int d = 0; d < ImageDimension; ++d)
+        {
+          derivative[d] = (static_cast<double>(v[i + upper[d]]) - v[i + lower[d]]) * scale[d];
+        }
+        function(i, derivative);
+      }
+    },
+    nullptr);
 }
 
 template <typename TInputImage, typename TOutputImage>

@@ -101,7 +101,7 @@ public:
 
 protected:
   IterativeMeshFilter();
-  ~IterativeMeshFilter() override = default;
+  ~IterativeMeshFilter() override;
 
   void
   PrintSelf(std::ostream & os, Indent indent) const override;
@@ -157,8 +157,15 @@ protected:
   UpdateOutputPoints();
 
 private:
+  using OutputCellsContainer = typename OutputMeshType::CellsContainer;
+
   void
   CacheInput();
+
+  /** Drops the clone of the input cells; deletes the cells when no output
+   * mesh shares them any more. */
+  void
+  ReleaseOutputCells();
 
   SizeValueType       m_NumberOfIterations{ 0 };
   SizeValueType       m_CurrentIteration{ 0 };
@@ -166,6 +173,11 @@ private:
   bool                m_Cached{ false };
   ModifiedTimeType    m_CachedInputTime{ 0 };
   std::vector<double> m_Coordinates;
+
+  // The output's structure and points, reused from one update to the next:
+  // cloning the cells at every update costs more than a step on large meshes.
+  typename OutputCellsContainer::Pointer  m_OutputCells;
+  typename OutputPointsContainer::Pointer m_OutputPoints;
 };
 } // end namespace itk
 

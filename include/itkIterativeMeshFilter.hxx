@@ -30,6 +30,28 @@ template <typename TInputMesh, typename TOutputMesh>
 IterativeMeshFilter<TInputMesh, TOutputMesh>::IterativeMeshFilter() = default;
 
 template <typename TInputMesh, typename TOutputMesh>
+IterativeMeshFilter<TInputMesh, TOutputMesh>::~IterativeMeshFilter()
+{
+  this->ReleaseOutputCells();
+}
+
+template <typename TInputMesh, typename TOutputMesh>
+void
+IterativeMeshFilter<TInputMesh, TOutputMesh>::ReleaseOutputCells()
+{
+  // The cells are allocated one by one; an output mesh that still shares the
+  // container deletes them when it releases it last.
+  if (m_OutputCells && m_OutputCells->GetReferenceCount() == 1)
+  {
+    for (auto it = m_OutputCells->Begin(); it != m_OutputCells->End(); ++it)
+    {
+      delete it.Value();
+    }
+  }
+  m_OutputCells = nullptr;
+}
+
+template <typename TInputMesh, typename TOutputMesh>
 void
 IterativeMeshFilter<TInputMesh, TOutputMesh>::VerifyPreconditions() ITKv5_CONST
 {
@@ -93,6 +115,7 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::GenerateData()
   if (restart)
   {
     m_Cached = false;
+    this->ReleaseOutputCells();
     this->CacheInput();
     m_CurrentIteration = 0;
     this->Reset();
@@ -100,7 +123,18 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::GenerateData()
   }
 
   // Structure first, so that an observer of IterationEvent sees a whole mesh.
-  this->CopyInputMeshToOutputMeshCells();
+  // The cells are cloned once per restart; later updates share the clone.
+  if (m_OutputCells.IsNull())
+  {
+    this->CopyInputMeshToOutputMeshCells();
+    m_OutputCells = this->GetOutput()->GetCells();
+  }
+  else
+  {
+    this->GetOutput()->SetCellsAllocationMethod(
+      MeshEnums::MeshClassCellsAllocationMethod::CellsAllocatedDynamicallyCellByCell);
+    this->GetOutput()->SetCells(m_OutputCells);
+  }
   this->CopyInputMeshToOutputMeshCellData();
   this->CopyInputMeshToOutputMeshPointData();
   this->UpdateOutputPoints();
@@ -130,9 +164,19 @@ void
 IterativeMeshFilter<TInputMesh, TOutputMesh>::UpdateOutputPoints()
 {
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
-  auto                points = OutputPointsContainer::New();
-  points->Reserve(numberOfPoints);
-  const double * x = m_Coordinates.data();
+  OutputMeshType *    output = this->GetOutput();
+  // Rewrite the container of the previous update in place unless someone else
+  // (an observer, a downstream filter) still holds it.
+  const bool reusable = m_OutputPoints && m_OutputPoints->Size() == numberOfPoints &&
+                        (m_OutputPoints->GetReferenceCount() == 1 ||
+                         (m_OutputPoints->GetReferenceCount() == 2 && output->GetPoints() == m_OutputPoints));
+  if (!reusable)
+  {
+    m_OutputPoints = OutputPointsContainer::New();
+    m_OutputPoints->Reserve(numberOfPoints);
+  }
+  OutputPointsContainer * points = m_OutputPoints;
+  const double *          x = m_Coordinates.data();
   for (SizeValueType i = 0; i < numberOfPoints; ++i, x += PointDimension)
   {
     OutputPointType & p = points->ElementAt(i);
@@ -141,7 +185,7 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::UpdateOutputPoints()
       p[d] = static_cast<typename OutputPointType::ValueType>(x[d]);
     }
   }
-  this->GetOutput()->SetPoints(points);
+  output->SetPoints(points);
 }
 
 template <typename TInputMesh, typename TOutputMesh>
@@ -154,6 +198,8 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::PrintSelf(std::ostream & os, Inden
   os << indent << "IterateFromZero: " << (m_IterateFromZero ? "On" : "Off") << std::endl;
   os << indent << "Cached: " << (m_Cached ? "true" : "false") << std::endl;
   os << indent << "CachedInputTime: " << m_CachedInputTime << std::endl;
+  os << indent << "OutputCells: " << (m_OutputCells ? m_OutputCells->Size() : 0) << " shared cells" << std::endl;
+  os << indent << "OutputPoints: " << (m_OutputPoints ? m_OutputPoints->Size() : 0) << " reusable points" << std::endl;
   os << indent << "Coordinates: " << this->GetNumberOfCachedPoints() << " cached points" << std::endl;
 }
 
