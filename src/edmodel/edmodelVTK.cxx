@@ -77,9 +77,7 @@ WritePolyDataMesh(const MeshType * mesh, const std::string & path)
     vtkNew<vtkXMLPolyDataWriter> writer;
     writer->SetInputData(polyData);
     writer->SetFileName(path.c_str());
-    // Inline binary, not appended: Debian's ParaView 5.11 cannot read appended
-    // data with the current expat (VTK issue 19258, expat reparse deferral).
-    writer->SetDataModeToBinary();
+    writer->SetDataModeToAppended();
     writer->SetCompressorTypeToZLib();
     written = writer->Write();
   }

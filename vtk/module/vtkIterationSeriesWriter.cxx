@@ -159,9 +159,7 @@ vtkIterationSeriesWriter::WriteIteration(vtkPolyData * mesh, int iteration)
   writer->SetInputData(mesh);
   if (this->Binary)
   {
-    // Inline binary, not appended: Debian's ParaView 5.11 cannot read appended
-    // data with the current expat (VTK issue 19258, expat reparse deferral).
-    writer->SetDataModeToBinary();
+    writer->SetDataModeToAppended();
   }
   else
   {

@@ -87,7 +87,7 @@ public:
 
   ///@{
   /**
-   * Binary (inline, compressed) .vtp files when on (default), ASCII when off.
+   * Binary (appended, compressed) .vtp files when on (default), ASCII when off.
    */
   vtkSetMacro(Binary, vtkTypeBool);
   vtkGetMacro(Binary, vtkTypeBool);
