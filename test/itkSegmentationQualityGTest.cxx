@@ -188,6 +188,10 @@ public:
     forces->SetInput(m_Image);
     forces->SetSigma(SigmaFor(m_Geometry, capture));
     forces->SetUseGradientVectorFlow(capture == Capture::GradientVectorFlow);
+    // Less regularisation, diffused longer (same reach): the field follows
+    // the high-curvature poles more closely than with the defaults.
+    forces->SetGradientVectorFlowRegularization(0.05);
+    forces->SetGradientVectorFlowIterations(800);
     forces->Update();
     ForceImageType::Pointer field = forces->GetOutput();
     field->DisconnectPipeline();
