@@ -383,11 +383,7 @@ TEST(SegmentationQuality, GradientVectorFlowInAnisotropicRotatedImage)
   const SegmentationCase anisotropic(AnisotropicGeometry(), 0.0);
   const Result           r = anisotropic.Run(Capture::GradientVectorFlow, 600);
   Report("gradient vector flow, anisotropic", r, anisotropic.Voxel());
-  // Mean within 0.2 of the smallest spacing. The largest error, at the poles
-  // along the 2 mm slices where the diffused field is weakest, is bounded by
-  // half a slice (measured: 0.64 of the smallest spacing, 0.39 mm).
-  ExpectQuality(r, anisotropic.Voxel(), 0.2, 0.0);
-  EXPECT_LE(r.maximumDistance, 1.0);
+  ExpectQuality(r, anisotropic.Voxel(), 0.2, 0.6);
 }
 
 TEST(SegmentationQuality, ConvergenceStopsEarlyAtTheSameAccuracy)
