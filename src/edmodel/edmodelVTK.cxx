@@ -77,7 +77,7 @@ WritePolyDataMesh(const MeshType * mesh, const std::string & path)
     vtkNew<vtkXMLPolyDataWriter> writer;
     writer->SetInputData(polyData);
     writer->SetFileName(path.c_str());
-    writer->SetDataModeToAppended();
+    writer->SetDataModeToBinary(); // inline: ParaView 5.11 on Debian 12 cannot parse appended data
     writer->SetCompressorTypeToZLib();
     written = writer->Write();
   }

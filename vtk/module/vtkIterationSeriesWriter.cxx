@@ -159,7 +159,7 @@ vtkIterationSeriesWriter::WriteIteration(vtkPolyData * mesh, int iteration)
   writer->SetInputData(mesh);
   if (this->Binary)
   {
-    writer->SetDataModeToAppended();
+    writer->SetDataModeToBinary(); // inline: ParaView 5.11 on Debian 12 cannot parse appended data
   }
   else
   {
