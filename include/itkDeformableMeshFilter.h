@@ -267,7 +267,6 @@ private:
   // Topology, unpacked once per Reset().
   std::vector<IndexType32> m_NeighbourOffsets;
   std::vector<IndexType32> m_Neighbours;
-  std::vector<IndexType32> m_Triangles;
   std::vector<IndexType32> m_VertexTriangleOffsets;
   std::vector<IndexType32> m_VertexTriangles; // pairs (b, c): the edge opposite the vertex
   SizeValueType            m_NumberOfTriangles{ 0 };

@@ -182,8 +182,9 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology()
   }
 
   std::vector<uint64_t> edges;
-  m_Triangles.clear();
-  auto addEdge = [&](uint64_t a, uint64_t b) {
+  // Triangles (polygons fan-triangulated), needed only to build the tables.
+  std::vector<IndexType32> triangles;
+  auto                     addEdge = [&](uint64_t a, uint64_t b) {
     if (a != b)
     {
       edges.push_back(std::min(a, b) << 32 | std::max(a, b));
@@ -219,9 +220,9 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology()
         // Fan triangulation, for normals.
         for (unsigned int k = 1; k + 1 < n; ++k)
         {
-          m_Triangles.push_back(static_cast<IndexType32>(ids[0]));
-          m_Triangles.push_back(static_cast<IndexType32>(ids[k]));
-          m_Triangles.push_back(static_cast<IndexType32>(ids[k + 1]));
+          triangles.push_back(static_cast<IndexType32>(ids[0]));
+          triangles.push_back(static_cast<IndexType32>(ids[k]));
+          triangles.push_back(static_cast<IndexType32>(ids[k + 1]));
         }
       }
       else if (isCurve || (isSurface && n == 2))
@@ -263,9 +264,9 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology()
   // CSR table of the edges opposite each vertex in its triangles, oriented as
   // the triangles: the normal of vertex i sums (b - x_i) x (c - x_i) over its
   // pairs (b, c), with no triangle indirection in the step.
-  const SizeValueType numberOfTriangles = m_Triangles.size() / 3;
+  const SizeValueType numberOfTriangles = triangles.size() / 3;
   m_VertexTriangleOffsets.assign(numberOfPoints + 1, 0);
-  for (const IndexType32 v : m_Triangles)
+  for (const IndexType32 v : triangles)
   {
     ++m_VertexTriangleOffsets[v + 1];
   }
@@ -280,9 +281,9 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology()
     {
       for (unsigned int k = 0; k < 3; ++k)
       {
-        IndexType32 * pair = m_VertexTriangles.data() + 2 * static_cast<SizeValueType>(fill[m_Triangles[3 * t + k]]++);
-        pair[0] = m_Triangles[3 * t + (k + 1) % 3];
-        pair[1] = m_Triangles[3 * t + (k + 2) % 3];
+        IndexType32 * pair = m_VertexTriangles.data() + 2 * static_cast<SizeValueType>(fill[triangles[3 * t + k]]++);
+        pair[0] = triangles[3 * t + (k + 1) % 3];
+        pair[1] = triangles[3 * t + (k + 2) % 3];
       }
     }
   }
@@ -292,15 +293,14 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology()
   double         volume = 0.0;
   for (SizeValueType t = 0; t < numberOfTriangles; ++t)
   {
-    const double * a = x + 3 * m_Triangles[3 * t];
-    const double * b = x + 3 * m_Triangles[3 * t + 1];
-    const double * c = x + 3 * m_Triangles[3 * t + 2];
+    const double * a = x + 3 * triangles[3 * t];
+    const double * b = x + 3 * triangles[3 * t + 1];
+    const double * c = x + 3 * triangles[3 * t + 2];
     volume +=
       a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
   }
   m_OrientationSign = volume < 0.0 ? -1.0 : 1.0;
   m_NumberOfTriangles = numberOfTriangles;
-  std::vector<IndexType32>().swap(m_Triangles); // only the opposite edges are needed from here on
 }
 
 template <typename TMesh, typename TForceImage>

@@ -20,7 +20,6 @@
 
 #include "itkExternalForceImageFilter.h"
 #include "itkCastImageFilter.h"
-#include "itkImageAlgorithm.h"
 #include "itkMultiThreaderBase.h"
 #include "itkProgressAccumulator.h"
 #include "itkSmoothingRecursiveGaussianImageFilter.h"
