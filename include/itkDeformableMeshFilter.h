@@ -20,6 +20,7 @@
 
 #include "itkIterativeMeshFilter.h"
 #include "itkImage.h"
+#include "itkDeformableMeshFilterDetail.h"
 
 #include <cstdint>
 #include <vector>
@@ -234,6 +235,18 @@ protected:
 
 private:
   using IndexType32 = uint32_t;
+  using Vec4 = DeformableMeshFilterDetail::Vec4;
+
+  /** How the neighbours of a vertex are stored: as the ordered ring of a
+   * closed fan of triangles (interior vertex), as an open fan (boundary
+   * vertex), or unordered with the vertex's triangles kept apart (any other
+   * case: polygons, lines, non-manifold vertices). */
+  enum RingKind : uint8_t
+  {
+    ClosedRing = 0,
+    OpenRing = 1,
+    GeneralVertex = 2
+  };
 
   void
   BuildTopology();
@@ -241,14 +254,52 @@ private:
   void
   PrepareForceSampler();
 
-  /** Trilinear sample of the force image at physical point x; false (and a zero
-   * force) outside the image. */
-  inline bool
-  SampleForce(const double * x, double * force) const;
+  /** What the step reads of the force image; copied to the stack of each
+   * block of vertices, so that the compiler keeps it in registers. */
+  struct ForceSampler
+  {
+    Vec4                   columns[3]; // of the physical-to-continuous-index matrix
+    Vec4                   offset;     // continuous index = columns * x - offset
+    Vec4                   lower;      // inside: lower <= index < upper
+    Vec4                   upper;
+    Vec4                   last;        // (lastX, lastY, lastZ, 0)
+    Vec4                   byteStrides; // bytes from a pixel to the next along x, y, z; 0
+    const ForcePixelType * buffer;
+    bool                   smallBuffer; // byte offsets fit in 32 bits
+    int64_t                lastX;
+    int64_t                lastY;
+    int64_t                lastZ;
+    int64_t                strideY;
+    int64_t                strideZ;
+    int64_t                lastPixel;
+  };
 
-  /** Outward (area-weighted, normalised) normal of vertex i. */
-  inline void
-  ComputeNormal(const double * coordinates, SizeValueType i, double * normal) const;
+  /** Trilinear sample of the force image at the physical point xi (lane 3
+   * ignored); zero outside the image. Lane 3 of the result is 0. */
+  static EDM_ALWAYS_INLINE Vec4
+  SampleForce(const ForceSampler & sampler, const Vec4 & xi);
+
+  /** Umbrella vector u (centroid of the neighbours minus the vertex) and,
+   * when NeedNormal, the outward unit normal n (area-weighted; 0 when
+   * undefined) of vertex i. Lane 3 of both is 0. */
+  template <bool NeedNormal>
+  EDM_ALWAYS_INLINE void
+  ComputeGeometry(const double * coordinates, SizeValueType i, Vec4 & u, Vec4 & n) const;
+
+  /** Umbrella vectors (and normals) of vertices [begin, end), first pass of
+   * a step with rigidity. */
+  template <bool NeedNormal>
+  void
+  GeometryBlock(SizeValueType begin, SizeValueType end);
+
+  /** The step of vertices [begin, end); returns their largest displacement. */
+  template <bool UseRigidity, bool UseNormal>
+  double
+  StepBlock(SizeValueType begin, SizeValueType end);
+
+  /** ComputeGeometry() for a GeneralVertex. */
+  void
+  ComputeGeneralGeometry(const double * coordinates, SizeValueType i, Vec4 & u, Vec4 & n) const;
 
   double       m_ScaleFactor{ 1.0 };
   double       m_Elasticity{ 0.0 };
@@ -264,27 +315,37 @@ private:
   double       m_LastMaximumDisplacement{ 0.0 };
   double       m_OrientationSign{ 1.0 };
 
-  // Topology, unpacked once per Reset().
+  // Topology, unpacked once per Reset(): CSR neighbour table, ring-ordered
+  // for ClosedRing and OpenRing vertices; the triangles of GeneralVertex
+  // vertices as pairs (b, c), the edge opposite the vertex, in a second CSR
+  // table indexed by their rank in m_GeneralVertices (sorted).
   std::vector<IndexType32> m_NeighbourOffsets;
   std::vector<IndexType32> m_Neighbours;
-  std::vector<IndexType32> m_VertexTriangleOffsets;
-  std::vector<IndexType32> m_VertexTriangles; // pairs (b, c): the edge opposite the vertex
+  std::vector<uint8_t>     m_RingKinds;
+  std::vector<IndexType32> m_GeneralVertices;
+  std::vector<IndexType32> m_GeneralPairOffsets;
+  std::vector<IndexType32> m_GeneralPairs;
   SizeValueType            m_NumberOfTriangles{ 0 };
 
-  // Per-vertex state.
+  // Per-vertex state. Next coordinates: 3 per vertex and a guard value, as
+  // the cached coordinates they are swapped with; umbrella vectors and
+  // normals (rigidity only): 4 per vertex.
   std::vector<double>  m_NextCoordinates;
   std::vector<double>  m_Umbrella;
+  std::vector<double>  m_Normals;
   std::vector<uint8_t> m_BalloonReleased;
   std::vector<float>   m_DisplacementMagnitudes;
   std::vector<float>   m_ExternalForceMagnitudes;
   std::vector<float>   m_InternalForceMagnitudes;
 
-  // Force sampler, prepared at each update.
+  // Force sampler, prepared at each update: continuous index
+  // c = M (x - origin) - bufferStart, with M's columns as vectors.
   const ForcePixelType * m_ForceBuffer{ nullptr };
   double                 m_PhysicalToIndex[3][3]{};
   double                 m_ForceOrigin[3]{};
   double                 m_BufferStart[3]{};
   int64_t                m_BufferSize[3]{};
+  ForceSampler           m_Sampler{};
 };
 } // end namespace itk
 

@@ -112,62 +112,142 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareForceSampler()
     m_BufferStart[r] = static_cast<double>(region.GetIndex()[r]);
     m_BufferSize[r] = static_cast<int64_t>(region.GetSize()[r]);
   }
+  // Continuous index c = M (x - origin) - start = M x - (M origin + start).
+  ForceSampler & sampler = m_Sampler;
+  for (unsigned int c = 0; c < 3; ++c)
+  {
+    sampler.columns[c] = Vec4{ m_PhysicalToIndex[0][c], m_PhysicalToIndex[1][c], m_PhysicalToIndex[2][c], 0.0 };
+  }
+  double offset[3];
+  for (unsigned int r = 0; r < 3; ++r)
+  {
+    offset[r] = m_PhysicalToIndex[r][0] * m_ForceOrigin[0] + m_PhysicalToIndex[r][1] * m_ForceOrigin[1] +
+                m_PhysicalToIndex[r][2] * m_ForceOrigin[2] + m_BufferStart[r];
+  }
+  sampler.offset = Vec4{ offset[0], offset[1], offset[2], 0.0 };
+  // Same inside test as itk::LinearInterpolateImageFunction: half a voxel
+  // beyond the first and last voxel centres, values clamped at the border.
+  constexpr double infinity = std::numeric_limits<double>::infinity();
+  sampler.lower = Vec4{ -0.5, -0.5, -0.5, -infinity };
+  sampler.upper = Vec4{ static_cast<double>(m_BufferSize[0]) - 0.5,
+                        static_cast<double>(m_BufferSize[1]) - 0.5,
+                        static_cast<double>(m_BufferSize[2]) - 0.5,
+                        infinity };
+  sampler.buffer = m_ForceBuffer;
+  sampler.lastX = m_BufferSize[0] - 1;
+  sampler.lastY = m_BufferSize[1] - 1;
+  sampler.lastZ = m_BufferSize[2] - 1;
+  sampler.strideY = m_BufferSize[0];
+  sampler.strideZ = m_BufferSize[0] * m_BufferSize[1];
+  sampler.lastPixel = m_BufferSize[0] * m_BufferSize[1] * m_BufferSize[2] - 1;
+  sampler.last = Vec4{ static_cast<double>(sampler.lastX),
+                       static_cast<double>(sampler.lastY),
+                       static_cast<double>(sampler.lastZ),
+                       0.0 };
+  constexpr double pixelBytes = sizeof(ForcePixelType);
+  sampler.byteStrides = Vec4{ pixelBytes,
+                              pixelBytes * static_cast<double>(sampler.strideY),
+                              pixelBytes * static_cast<double>(sampler.strideZ),
+                              0.0 };
+  sampler.smallBuffer = (sampler.lastPixel + 1) * static_cast<int64_t>(sizeof(ForcePixelType)) <
+                        static_cast<int64_t>(std::numeric_limits<int32_t>::max());
 }
 
 template <typename TMesh, typename TForceImage>
-inline bool
-DeformableMeshFilter<TMesh, TForceImage>::SampleForce(const double * x, double * force) const
+EDM_ALWAYS_INLINE auto
+DeformableMeshFilter<TMesh, TForceImage>::SampleForce(const ForceSampler & sampler, const Vec4 & xi) -> Vec4
 {
-  const double d[3] = { x[0] - m_ForceOrigin[0], x[1] - m_ForceOrigin[1], x[2] - m_ForceOrigin[2] };
-  int64_t      i0[3];
-  int64_t      i1[3];
-  double       w[3];
-  for (unsigned int k = 0; k < 3; ++k)
+  using namespace DeformableMeshFilterDetail;
+  const Vec4 c = sampler.columns[0] * Splat(xi[0]) + sampler.columns[1] * Splat(xi[1]) +
+                 sampler.columns[2] * Splat(xi[2]) - sampler.offset;
+  if (!InsideBox(c, sampler.lower, sampler.upper))
   {
-    const double c = m_PhysicalToIndex[k][0] * d[0] + m_PhysicalToIndex[k][1] * d[1] + m_PhysicalToIndex[k][2] * d[2] -
-                     m_BufferStart[k];
-    // Same inside test as itk::LinearInterpolateImageFunction: half a voxel
-    // beyond the first and last voxel centres, values clamped at the border.
-    if (!(c >= -0.5 && c < static_cast<double>(m_BufferSize[k]) - 0.5))
+    return Vec4{};
+  }
+#if defined(__AVX__)
+  if (sampler.smallBuffer)
+  {
+    // The eight byte offsets, two vectors of four, from the clamped corners.
+    const __m256d f = _mm256_floor_pd(c);
+    const Vec4    w = c - f;
+    const Vec4    low = _mm256_max_pd(f, _mm256_setzero_pd()) * sampler.byteStrides;       // (x0, y0, z0, 0)
+    const Vec4    high = _mm256_min_pd(f + Splat(1.0), sampler.last) * sampler.byteStrides; // (x1, y1, z1, 0)
+    const __m256d xz = _mm256_unpacklo_pd(low, high);                                      // (x0, x1, z0, z1)
+    const __m256d yy = _mm256_unpackhi_pd(low, high);                                      // (y0, y1, 0, 0)
+    const __m256d yz = _mm256_add_pd(_mm256_permute4x64_pd(yy, 0x44), _mm256_permute4x64_pd(xz, 0xfa));
+    const __m128i atX0 = _mm256_cvttpd_epi32(_mm256_add_pd(yz, _mm256_permute4x64_pd(xz, 0x00)));
+    const __m128i atX1 = _mm256_cvttpd_epi32(_mm256_add_pd(yz, _mm256_permute4x64_pd(xz, 0x55)));
+    const char *  bytes = reinterpret_cast<const char *>(sampler.buffer);
+    auto          blend = [&](auto load) {
+      auto       at = [bytes](int offset) -> const ForcePixelType & {
+        return *reinterpret_cast<const ForcePixelType *>(bytes + offset);
+      };
+      const Vec4 p000 = load(at(_mm_cvtsi128_si32(atX0)));
+      const Vec4 p100 = load(at(_mm_cvtsi128_si32(atX1)));
+      const Vec4 p010 = load(at(_mm_extract_epi32(atX0, 1)));
+      const Vec4 p110 = load(at(_mm_extract_epi32(atX1, 1)));
+      const Vec4 p001 = load(at(_mm_extract_epi32(atX0, 2)));
+      const Vec4 p101 = load(at(_mm_extract_epi32(atX1, 2)));
+      const Vec4 p011 = load(at(_mm_extract_epi32(atX0, 3)));
+      const Vec4 p111 = load(at(_mm_extract_epi32(atX1, 3)));
+      const Vec4 vx = Splat(w[0]);
+      const Vec4 a00 = p000 + vx * (p100 - p000);
+      const Vec4 a10 = p010 + vx * (p110 - p010);
+      const Vec4 a01 = p001 + vx * (p101 - p001);
+      const Vec4 a11 = p011 + vx * (p111 - p011);
+      const Vec4 vy = Splat(w[1]);
+      const Vec4 near = a00 + vy * (a10 - a00);
+      const Vec4 far = a01 + vy * (a11 - a01);
+      return ClearLane3(near + Splat(w[2]) * (far - near));
+    };
+    // A padded load reads past the pixel: not at the last pixel of the buffer.
+    if (_mm_extract_epi32(atX1, 3) < sampler.lastPixel * static_cast<int64_t>(sizeof(ForcePixelType)))
     {
-      force[0] = force[1] = force[2] = 0.0;
-      return false;
+      return blend([](const ForcePixelType & v) { return PixelLoader<ForcePixelType, true>::Load(v); });
     }
-    const double floorC = std::floor(c);
-    w[k] = c - floorC;
-    const auto base = static_cast<int64_t>(floorC);
-    i0[k] = std::max<int64_t>(base, 0);
-    i1[k] = std::min<int64_t>(base + 1, m_BufferSize[k] - 1);
+    return blend([](const ForcePixelType & v) { return PixelLoader<ForcePixelType, false>::Load(v); });
   }
-  const int64_t strideY = m_BufferSize[0];
-  const int64_t strideZ = m_BufferSize[0] * m_BufferSize[1];
-  const int64_t z0 = i0[2] * strideZ;
-  const int64_t z1 = i1[2] * strideZ;
-  const int64_t y0 = i0[1] * strideY;
-  const int64_t y1 = i1[1] * strideY;
+#endif
+  // c >= -0.5, so truncating c + 1 gives floor(c) + 1.
+  const auto    fx = static_cast<int64_t>(c[0] + 1.0) - 1;
+  const auto    fy = static_cast<int64_t>(c[1] + 1.0) - 1;
+  const auto    fz = static_cast<int64_t>(c[2] + 1.0) - 1;
+  const double  wx = c[0] - static_cast<double>(fx);
+  const double  wy = c[1] - static_cast<double>(fy);
+  const double  wz = c[2] - static_cast<double>(fz);
+  const int64_t x0 = std::max<int64_t>(fx, 0);
+  const int64_t x1 = std::min<int64_t>(fx + 1, sampler.lastX);
+  const int64_t y0 = std::max<int64_t>(fy, 0) * sampler.strideY;
+  const int64_t y1 = std::min<int64_t>(fy + 1, sampler.lastY) * sampler.strideY;
+  const int64_t z0 = std::max<int64_t>(fz, 0) * sampler.strideZ;
+  const int64_t z1 = std::min<int64_t>(fz + 1, sampler.lastZ) * sampler.strideZ;
 
-  const ForcePixelType & p000 = m_ForceBuffer[z0 + y0 + i0[0]];
-  const ForcePixelType & p100 = m_ForceBuffer[z0 + y0 + i1[0]];
-  const ForcePixelType & p010 = m_ForceBuffer[z0 + y1 + i0[0]];
-  const ForcePixelType & p110 = m_ForceBuffer[z0 + y1 + i1[0]];
-  const ForcePixelType & p001 = m_ForceBuffer[z1 + y0 + i0[0]];
-  const ForcePixelType & p101 = m_ForceBuffer[z1 + y0 + i1[0]];
-  const ForcePixelType & p011 = m_ForceBuffer[z1 + y1 + i0[0]];
-  const ForcePixelType & p111 = m_ForceBuffer[z1 + y1 + i1[0]];
-  const double           wx = w[0];
-  const double           wy = w[1];
-  const double           wz = w[2];
-  for (unsigned int k = 0; k < 3; ++k)
+  const ForcePixelType * p = sampler.buffer;
+  auto                   blend = [=](auto load) {
+    const Vec4 p000 = load(p[z0 + y0 + x0]);
+    const Vec4 p100 = load(p[z0 + y0 + x1]);
+    const Vec4 p010 = load(p[z0 + y1 + x0]);
+    const Vec4 p110 = load(p[z0 + y1 + x1]);
+    const Vec4 p001 = load(p[z1 + y0 + x0]);
+    const Vec4 p101 = load(p[z1 + y0 + x1]);
+    const Vec4 p011 = load(p[z1 + y1 + x0]);
+    const Vec4 p111 = load(p[z1 + y1 + x1]);
+    const Vec4 vx = Splat(wx);
+    const Vec4 a00 = p000 + vx * (p100 - p000);
+    const Vec4 a10 = p010 + vx * (p110 - p010);
+    const Vec4 a01 = p001 + vx * (p101 - p001);
+    const Vec4 a11 = p011 + vx * (p111 - p011);
+    const Vec4 vy = Splat(wy);
+    const Vec4 near = a00 + vy * (a10 - a00);
+    const Vec4 far = a01 + vy * (a11 - a01);
+    return ClearLane3(near + Splat(wz) * (far - near));
+  };
+  // A padded load reads past the pixel: not at the last pixel of the buffer.
+  if (z1 + y1 + x1 < sampler.lastPixel)
   {
-    const double a00 = p000[k] + wx * (p100[k] - p000[k]);
-    const double a10 = p010[k] + wx * (p110[k] - p010[k]);
-    const double a01 = p001[k] + wx * (p101[k] - p001[k]);
-    const double a11 = p011[k] + wx * (p111[k] - p011[k]);
-    const double b0 = a00 + wy * (a10 - a00);
-    const double b1 = a01 + wy * (a11 - a01);
-    force[k] = b0 + wz * (b1 - b0);
+    return blend([](const ForcePixelType & v) { return PixelLoader<ForcePixelType, true>::Load(v); });
   }
-  return true;
+  return blend([](const ForcePixelType & v) { return PixelLoader<ForcePixelType, false>::Load(v); });
 }
 
 template <typename TMesh, typename TForceImage>
@@ -260,31 +340,123 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology()
       m_Neighbours[fill[b]++] = a;
     }
   }
+  std::vector<uint64_t>().swap(edges);
 
-  // CSR table of the edges opposite each vertex in its triangles, oriented as
-  // the triangles: the normal of vertex i sums (b - x_i) x (c - x_i) over its
-  // pairs (b, c), with no triangle indirection in the step.
-  const SizeValueType numberOfTriangles = triangles.size() / 3;
-  m_VertexTriangleOffsets.assign(numberOfPoints + 1, 0);
+  // For each vertex, the edges opposite it in its triangles, oriented as the
+  // triangles: pairs (b, c); its normal sums (b - x) x (c - x) over them.
+  const SizeValueType      numberOfTriangles = triangles.size() / 3;
+  std::vector<IndexType32> pairOffsets(numberOfPoints + 1, 0);
   for (const IndexType32 v : triangles)
   {
-    ++m_VertexTriangleOffsets[v + 1];
+    ++pairOffsets[v + 1];
   }
   for (SizeValueType i = 0; i < numberOfPoints; ++i)
   {
-    m_VertexTriangleOffsets[i + 1] += m_VertexTriangleOffsets[i];
+    pairOffsets[i + 1] += pairOffsets[i];
   }
-  m_VertexTriangles.resize(2 * static_cast<SizeValueType>(m_VertexTriangleOffsets[numberOfPoints]));
+  std::vector<IndexType32> pairs(2 * static_cast<SizeValueType>(pairOffsets[numberOfPoints]));
   {
-    std::vector<IndexType32> fill(m_VertexTriangleOffsets.begin(), m_VertexTriangleOffsets.end() - 1);
+    std::vector<IndexType32> fill(pairOffsets.begin(), pairOffsets.end() - 1);
     for (SizeValueType t = 0; t < numberOfTriangles; ++t)
     {
       for (unsigned int k = 0; k < 3; ++k)
       {
-        IndexType32 * pair = m_VertexTriangles.data() + 2 * static_cast<SizeValueType>(fill[triangles[3 * t + k]]++);
+        IndexType32 * pair = pairs.data() + 2 * static_cast<SizeValueType>(fill[triangles[3 * t + k]]++);
         pair[0] = triangles[3 * t + (k + 1) % 3];
         pair[1] = triangles[3 * t + (k + 2) % 3];
       }
+    }
+  }
+
+  // Where the pairs chain into one fan (c of a pair is b of the next) whose
+  // vertices are exactly the vertex's neighbours, store the neighbours in fan
+  // order: the step then gets the umbrella vector and the normal from the
+  // same loads, sum (x_j - x) and sum (x_j - x) x (x_j+1 - x). Otherwise keep
+  // the vertex's pairs apart.
+  m_RingKinds.assign(numberOfPoints, GeneralVertex);
+  m_GeneralVertices.clear();
+  m_GeneralPairOffsets.assign(1, 0);
+  m_GeneralPairs.clear();
+  std::vector<IndexType32> ring;
+  std::vector<IndexType32> sortedRing;
+  std::vector<IndexType32> sortedNeighbours;
+  std::vector<uint8_t>     used;
+  for (SizeValueType i = 0; i < numberOfPoints; ++i)
+  {
+    const IndexType32 * vertexPairs = pairs.data() + 2 * static_cast<SizeValueType>(pairOffsets[i]);
+    const IndexType32   numberOfPairs = pairOffsets[i + 1] - pairOffsets[i];
+    const IndexType32   numberOfNeighbours = m_NeighbourOffsets[i + 1] - m_NeighbourOffsets[i];
+    RingKind            kind = GeneralVertex;
+    if (numberOfNeighbours == 0)
+    {
+      kind = ClosedRing; // isolated vertex: no umbrella, no normal
+    }
+    else if (numberOfPairs > 0)
+    {
+      // Start at a pair whose b ends no other pair (a boundary fan), if any.
+      IndexType32 start = 0;
+      unsigned    boundaryStarts = 0;
+      for (IndexType32 p = 0; p < numberOfPairs; ++p)
+      {
+        bool ended = false;
+        for (IndexType32 q = 0; q < numberOfPairs && !ended; ++q)
+        {
+          ended = vertexPairs[2 * q + 1] == vertexPairs[2 * p];
+        }
+        if (!ended)
+        {
+          start = p;
+          ++boundaryStarts;
+        }
+      }
+      used.assign(numberOfPairs, 0);
+      ring.assign(1, vertexPairs[2 * start]);
+      used[start] = 1;
+      IndexType32 last = vertexPairs[2 * start + 1];
+      IndexType32 chained = 1;
+      for (bool found = true; found && chained < numberOfPairs;)
+      {
+        found = false;
+        for (IndexType32 q = 0; q < numberOfPairs; ++q)
+        {
+          if (!used[q] && vertexPairs[2 * q] == last)
+          {
+            ring.push_back(last);
+            used[q] = 1;
+            last = vertexPairs[2 * q + 1];
+            ++chained;
+            found = true;
+            break;
+          }
+        }
+      }
+      RingKind candidate = ClosedRing;
+      if (last != ring.front())
+      {
+        ring.push_back(last);
+        candidate = OpenRing;
+      }
+      if (chained == numberOfPairs && boundaryStarts <= 1 && (candidate == OpenRing) == (boundaryStarts == 1) &&
+          ring.size() == numberOfNeighbours)
+      {
+        sortedRing = ring;
+        std::sort(sortedRing.begin(), sortedRing.end());
+        sortedNeighbours.assign(m_Neighbours.begin() + m_NeighbourOffsets[i],
+                                m_Neighbours.begin() + m_NeighbourOffsets[i + 1]);
+        std::sort(sortedNeighbours.begin(), sortedNeighbours.end());
+        if (sortedRing == sortedNeighbours)
+        {
+          kind = candidate;
+          std::copy(ring.begin(), ring.end(), m_Neighbours.begin() + m_NeighbourOffsets[i]);
+        }
+      }
+    }
+    m_RingKinds[i] = kind;
+    if (kind == GeneralVertex)
+    {
+      m_GeneralVertices.push_back(static_cast<IndexType32>(i));
+      m_GeneralPairs.insert(m_GeneralPairs.end(), vertexPairs, vertexPairs + 2 * numberOfPairs);
+      m_GeneralPairOffsets.push_back(static_cast<IndexType32>(m_GeneralPairs.size() / 2));
     }
   }
 
@@ -309,8 +481,10 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
 {
   this->BuildTopology();
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
-  m_NextCoordinates.resize(3 * numberOfPoints);
+  // As the cached coordinates: 3 per point and a guard value.
+  m_NextCoordinates.assign(3 * numberOfPoints + 1, 0.0);
   std::vector<double>().swap(m_Umbrella);
+  std::vector<double>().swap(m_Normals);
   m_BalloonReleased.clear();
   m_DisplacementMagnitudes.clear();
   m_ExternalForceMagnitudes.clear();
@@ -321,50 +495,116 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
 }
 
 template <typename TMesh, typename TForceImage>
+template <bool NeedNormal>
 inline void
-DeformableMeshFilter<TMesh, TForceImage>::ComputeNormal(const double * x, SizeValueType i, double * normal) const
+DeformableMeshFilter<TMesh, TForceImage>::ComputeGeometry(const double * x, SizeValueType i, Vec4 & u, Vec4 & n) const
 {
-  double n[3] = { 0.0, 0.0, 0.0 };
-  for (IndexType32 k = m_VertexTriangleOffsets[i]; k < m_VertexTriangleOffsets[i + 1]; ++k)
+  using namespace DeformableMeshFilterDetail;
+  const uint8_t kind = m_RingKinds[i];
+  if (kind == GeneralVertex)
   {
-    const double * a = x + 3 * i;
-    const double * b = x + 3 * m_VertexTriangles[2 * k];
-    const double * c = x + 3 * m_VertexTriangles[2 * k + 1];
-    const double   u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
-    const double   v[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
-    n[0] += u[1] * v[2] - u[2] * v[1];
-    n[1] += u[2] * v[0] - u[0] * v[2];
-    n[2] += u[0] * v[1] - u[1] * v[0];
+    this->ComputeGeneralGeometry(x, i, u, n);
+    return;
   }
-  const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  const IndexType32   begin = m_NeighbourOffsets[i];
+  const IndexType32   end = m_NeighbourOffsets[i + 1];
+  const IndexType32 * ring = m_Neighbours.data();
+  if (begin == end)
+  {
+    u = Vec4{};
+    n = Vec4{};
+    return;
+  }
+  // Relative to x_i, so that the cross products do not lose digits to the
+  // distance from the origin. Lane 3 carries junk (the next coordinate in
+  // memory) until cleared.
+  const Vec4 xi = Load4(x + 3 * i);
+  const Vec4 first = Load4(x + 3 * static_cast<SizeValueType>(ring[begin])) - xi;
+  const Vec4 firstRotated = Rotate(first);
+  Vec4       sum = first;
+  Vec4       twisted{}; // sum of d_j * R(d_j+1) - R(d_j) * d_j+1; R(twisted) is sum of d_j x d_j+1
+  Vec4       previous = first;
+  Vec4       previousRotated = firstRotated;
+  for (IndexType32 k = begin + 1; k < end; ++k)
+  {
+    const Vec4 d = Load4(x + 3 * static_cast<SizeValueType>(ring[k])) - xi;
+    sum += d;
+    if (NeedNormal)
+    {
+      const Vec4 rotated = Rotate(d);
+      twisted += previous * rotated - previousRotated * d;
+      previous = d;
+      previousRotated = rotated;
+    }
+  }
+  u = ClearLane3(sum * Splat(InverseCount(end - begin)));
+  if (NeedNormal)
+  {
+    if (kind == ClosedRing)
+    {
+      twisted += previous * firstRotated - previousRotated * first;
+    }
+    const Vec4   normal = ClearLane3(Rotate(twisted));
+    const double squaredLength = Dot3(normal, normal);
+    n = squaredLength > 0.0 ? normal * Splat(m_OrientationSign / std::sqrt(squaredLength)) : Vec4{};
+  }
+}
+
+template <typename TMesh, typename TForceImage>
+void
+DeformableMeshFilter<TMesh, TForceImage>::ComputeGeneralGeometry(const double * x,
+                                                                 SizeValueType  i,
+                                                                 Vec4 &         u,
+                                                                 Vec4 &         n) const
+{
+  using namespace DeformableMeshFilterDetail;
+  const double * xi = x + 3 * i;
+  double         s[3] = { 0.0, 0.0, 0.0 };
+  const auto     begin = m_NeighbourOffsets[i];
+  const auto     end = m_NeighbourOffsets[i + 1];
+  for (IndexType32 k = begin; k < end; ++k)
+  {
+    const double * y = x + 3 * static_cast<SizeValueType>(m_Neighbours[k]);
+    s[0] += y[0] - xi[0];
+    s[1] += y[1] - xi[1];
+    s[2] += y[2] - xi[2];
+  }
+  const double inverseCount = end > begin ? 1.0 / static_cast<double>(end - begin) : 0.0;
+  u = Vec4{ s[0] * inverseCount, s[1] * inverseCount, s[2] * inverseCount, 0.0 };
+
+  const auto   rank = static_cast<SizeValueType>(
+    std::lower_bound(m_GeneralVertices.begin(), m_GeneralVertices.end(), static_cast<IndexType32>(i)) -
+    m_GeneralVertices.begin());
+  double       normal[3] = { 0.0, 0.0, 0.0 };
+  for (IndexType32 k = m_GeneralPairOffsets[rank]; k < m_GeneralPairOffsets[rank + 1]; ++k)
+  {
+    const double * b = x + 3 * static_cast<SizeValueType>(m_GeneralPairs[2 * k]);
+    const double * c = x + 3 * static_cast<SizeValueType>(m_GeneralPairs[2 * k + 1]);
+    const double   e[3] = { b[0] - xi[0], b[1] - xi[1], b[2] - xi[2] };
+    const double   f[3] = { c[0] - xi[0], c[1] - xi[1], c[2] - xi[2] };
+    normal[0] += e[1] * f[2] - e[2] * f[1];
+    normal[1] += e[2] * f[0] - e[0] * f[2];
+    normal[2] += e[0] * f[1] - e[1] * f[0];
+  }
+  const double length = std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
   const double scale = length > 0.0 ? m_OrientationSign / length : 0.0;
-  normal[0] = n[0] * scale;
-  normal[1] = n[1] * scale;
-  normal[2] = n[2] * scale;
+  n = Vec4{ normal[0] * scale, normal[1] * scale, normal[2] * scale, 0.0 };
 }
 
 template <typename TMesh, typename TForceImage>
 void
 DeformableMeshFilter<TMesh, TForceImage>::Iterate()
 {
+  using namespace DeformableMeshFilterDetail;
   std::vector<double> & coordinates = this->GetCoordinates();
   const SizeValueType   numberOfPoints = this->GetNumberOfCachedPoints();
-  const double *        x = coordinates.data();
-  double *              next = m_NextCoordinates.data();
 
   // Stability of the explicit internal update requires a + 2b <= 1.
-  const double        internalSum = m_Elasticity + 2.0 * m_Rigidity;
-  const double        internalScale = internalSum > 1.0 ? 1.0 / internalSum : 1.0;
-  const double        elasticity = m_Elasticity * internalScale;
-  const double        rigidity = m_Rigidity * internalScale;
-  const bool          useElasticity = elasticity > 0.0;
-  const bool          useRigidity = rigidity > 0.0;
-  const bool          useNormal = m_Balloon != 0.0 || (useElasticity && m_TangentialElasticity);
-  const double        scaleFactor = m_ScaleFactor;
-  const double        balloon = m_Balloon;
-  const double        maximumStep = m_MaximumStepLength;
-  const IndexType32 * offsets = m_NeighbourOffsets.data();
-  const IndexType32 * neighbours = m_Neighbours.data();
+  const double internalSum = m_Elasticity + 2.0 * m_Rigidity;
+  const double internalScale = internalSum > 1.0 ? 1.0 / internalSum : 1.0;
+  const bool   useElasticity = m_Elasticity * internalScale > 0.0;
+  const bool   useRigidity = m_Rigidity * internalScale > 0.0;
+  const bool   useNormal = m_Balloon != 0.0 || (useElasticity && m_TangentialElasticity);
 
   if (m_DisplacementMagnitudes.size() != numberOfPoints)
   {
@@ -376,55 +616,37 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   {
     m_BalloonReleased.assign(numberOfPoints, 0);
   }
-  uint8_t * balloonReleased = m_BalloonReleased.data();
-  float *   displacementMagnitudes = m_DisplacementMagnitudes.data();
-  float *   externalMagnitudes = m_ExternalForceMagnitudes.data();
-  float *   internalMagnitudes = m_InternalForceMagnitudes.data();
-
-  // Umbrella vector: centroid of the neighbours minus the vertex.
-  auto umbrella = [x, offsets, neighbours](SizeValueType i, double * u) {
-    const IndexType32 begin = offsets[i];
-    const IndexType32 end = offsets[i + 1];
-    if (begin == end)
-    {
-      u[0] = u[1] = u[2] = 0.0;
-      return;
-    }
-    double s[3] = { 0.0, 0.0, 0.0 };
-    for (IndexType32 k = begin; k < end; ++k)
-    {
-      const double * y = x + 3 * neighbours[k];
-      s[0] += y[0];
-      s[1] += y[1];
-      s[2] += y[2];
-    }
-    const double   inverseCount = 1.0 / static_cast<double>(end - begin);
-    const double * xi = x + 3 * i;
-    u[0] = s[0] * inverseCount - xi[0];
-    u[1] = s[1] * inverseCount - xi[1];
-    u[2] = s[2] * inverseCount - xi[2];
-  };
 
   constexpr SizeValueType blockSize = 2048;
   const SizeValueType     numberOfBlocks = (numberOfPoints + blockSize - 1) / blockSize;
   MultiThreaderBase *     threader = this->GetMultiThreader();
   threader->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
 
-  if (useRigidity && m_Umbrella.size() != 3 * numberOfPoints)
-  {
-    m_Umbrella.resize(3 * numberOfPoints);
-  }
-  double * umbrellaField = m_Umbrella.data();
+  // With rigidity, a first pass stores the umbrella vectors (and normals) of
+  // all vertices: the rigidity force is the umbrella of the umbrella field.
   if (useRigidity)
   {
+    if (m_Umbrella.size() != 4 * numberOfPoints)
+    {
+      m_Umbrella.assign(4 * numberOfPoints, 0.0);
+    }
+    if (useNormal && m_Normals.size() != 4 * numberOfPoints)
+    {
+      m_Normals.assign(4 * numberOfPoints, 0.0);
+    }
     threader->ParallelizeArray(
       0,
       numberOfBlocks,
-      [&](SizeValueType block) {
-        const SizeValueType end = std::min(numberOfPoints, (block + 1) * blockSize);
-        for (SizeValueType i = block * blockSize; i < end; ++i)
+      [this, numberOfPoints, useNormal](SizeValueType block) {
+        const SizeValueType begin = block * blockSize;
+        const SizeValueType end = std::min(numberOfPoints, begin + blockSize);
+        if (useNormal)
         {
-          umbrella(i, umbrellaField + 3 * i);
+          this->GeometryBlock<true>(begin, end);
+        }
+        else
+        {
+          this->GeometryBlock<false>(begin, end);
         }
       },
       nullptr);
@@ -434,109 +656,17 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   threader->ParallelizeArray(
     0,
     numberOfBlocks,
-    [&](SizeValueType block) {
-      double              largest = 0.0;
-      const SizeValueType end = std::min(numberOfPoints, (block + 1) * blockSize);
-      for (SizeValueType i = block * blockSize; i < end; ++i)
+    [this, numberOfPoints, useRigidity, useNormal, &blockMaximum](SizeValueType block) {
+      const SizeValueType begin = block * blockSize;
+      const SizeValueType end = std::min(numberOfPoints, begin + blockSize);
+      if (useRigidity)
       {
-        const double * xi = x + 3 * i;
-        double         external[3];
-        this->SampleForce(xi, external);
-        double delta[3] = { scaleFactor * external[0], scaleFactor * external[1], scaleFactor * external[2] };
-        double internal[3] = { 0.0, 0.0, 0.0 };
-
-        double normal[3] = { 0.0, 0.0, 0.0 };
-        if (useNormal)
-        {
-          this->ComputeNormal(x, i, normal);
-        }
-        if (useElasticity || useRigidity)
-        {
-          double u[3];
-          if (useRigidity)
-          {
-            u[0] = umbrellaField[3 * i];
-            u[1] = umbrellaField[3 * i + 1];
-            u[2] = umbrellaField[3 * i + 2];
-          }
-          else
-          {
-            umbrella(i, u);
-          }
-          if (useElasticity)
-          {
-            double e[3] = { u[0], u[1], u[2] };
-            if (m_TangentialElasticity)
-            {
-              const double normalPart = e[0] * normal[0] + e[1] * normal[1] + e[2] * normal[2];
-              e[0] -= normalPart * normal[0];
-              e[1] -= normalPart * normal[1];
-              e[2] -= normalPart * normal[2];
-            }
-            internal[0] += elasticity * e[0];
-            internal[1] += elasticity * e[1];
-            internal[2] += elasticity * e[2];
-          }
-          if (useRigidity && offsets[i + 1] > offsets[i])
-          {
-            double mean[3] = { 0.0, 0.0, 0.0 };
-            for (IndexType32 k = offsets[i]; k < offsets[i + 1]; ++k)
-            {
-              const double * uj = umbrellaField + 3 * neighbours[k];
-              mean[0] += uj[0];
-              mean[1] += uj[1];
-              mean[2] += uj[2];
-            }
-            const double inverseCount = 1.0 / static_cast<double>(offsets[i + 1] - offsets[i]);
-            internal[0] -= rigidity * (mean[0] * inverseCount - u[0]);
-            internal[1] -= rigidity * (mean[1] * inverseCount - u[1]);
-            internal[2] -= rigidity * (mean[2] * inverseCount - u[2]);
-          }
-        }
-        // The balloon carries a vertex to an edge, not past it: once the
-        // external force opposes it with half its strength, the vertex is in
-        // the edge's capture range and the balloon is released for it, so that
-        // it settles on the edge itself instead of where the forces balance.
-        double inflation = 0.0;
-        if (balloon != 0.0 && !balloonReleased[i])
-        {
-          const double externalAlongNormal = delta[0] * normal[0] + delta[1] * normal[1] + delta[2] * normal[2];
-          if (balloon * externalAlongNormal <= -0.5 * balloon * balloon)
-          {
-            balloonReleased[i] = 1;
-          }
-          else
-          {
-            inflation = balloon;
-          }
-        }
-        delta[0] += internal[0] + inflation * normal[0];
-        delta[1] += internal[1] + inflation * normal[1];
-        delta[2] += internal[2] + inflation * normal[2];
-
-        double length = std::sqrt(delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2]);
-        if (maximumStep > 0.0 && length > maximumStep)
-        {
-          const double shrink = maximumStep / length;
-          delta[0] *= shrink;
-          delta[1] *= shrink;
-          delta[2] *= shrink;
-          length = maximumStep;
-        }
-        double * xn = next + 3 * i;
-        xn[0] = xi[0] + delta[0];
-        xn[1] = xi[1] + delta[1];
-        xn[2] = xi[2] + delta[2];
-
-        displacementMagnitudes[i] = static_cast<float>(length);
-        externalMagnitudes[i] =
-          static_cast<float>(std::abs(scaleFactor) * std::sqrt(external[0] * external[0] + external[1] * external[1] +
-                                                               external[2] * external[2]));
-        internalMagnitudes[i] = static_cast<float>(
-          std::sqrt(internal[0] * internal[0] + internal[1] * internal[1] + internal[2] * internal[2]));
-        largest = std::max(largest, length);
+        blockMaximum[block] = useNormal ? this->StepBlock<true, true>(begin, end) : this->StepBlock<true, false>(begin, end);
       }
-      blockMaximum[block] = largest;
+      else
+      {
+        blockMaximum[block] = useNormal ? this->StepBlock<false, true>(begin, end) : this->StepBlock<false, false>(begin, end);
+      }
     },
     nullptr);
 
@@ -551,6 +681,160 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   {
     m_QuietIterations = 0;
   }
+}
+
+template <typename TMesh, typename TForceImage>
+template <bool NeedNormal>
+void
+DeformableMeshFilter<TMesh, TForceImage>::GeometryBlock(SizeValueType begin, SizeValueType end)
+{
+  using namespace DeformableMeshFilterDetail;
+  const double * x = this->GetCoordinates().data();
+  double *       umbrellaField = m_Umbrella.data();
+  double *       normalField = m_Normals.data();
+  Vec4           u;
+  Vec4           n;
+  for (SizeValueType i = begin; i < end; ++i)
+  {
+    this->template ComputeGeometry<NeedNormal>(x, i, u, n);
+    Store4(umbrellaField + 4 * i, u);
+    if (NeedNormal)
+    {
+      Store4(normalField + 4 * i, n);
+    }
+  }
+}
+
+template <typename TMesh, typename TForceImage>
+template <bool UseRigidity, bool UseNormal>
+double
+DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeValueType end)
+{
+  using namespace DeformableMeshFilterDetail;
+  // Everything the loop reads, in locals: the compiler cannot keep members in
+  // registers across the stores to the output arrays.
+  const double        internalSum = m_Elasticity + 2.0 * m_Rigidity;
+  const double        internalScale = internalSum > 1.0 ? 1.0 / internalSum : 1.0;
+  const double        elasticity = m_Elasticity * internalScale;
+  const double        rigidity = m_Rigidity * internalScale;
+  const bool          useElasticity = elasticity > 0.0;
+  const bool          tangential = useElasticity && m_TangentialElasticity;
+  const double        scaleFactor = m_ScaleFactor;
+  const double        balloon = m_Balloon;
+  const double        maximumStep = m_MaximumStepLength;
+  const ForceSampler  sampler = m_Sampler;
+  const double *      x = this->GetCoordinates().data();
+  double *            next = m_NextCoordinates.data();
+  const double *      umbrellaField = m_Umbrella.data();
+  const double *      normalField = m_Normals.data();
+  const IndexType32 * offsets = m_NeighbourOffsets.data();
+  const IndexType32 * neighbours = m_Neighbours.data();
+  uint8_t *           balloonReleased = m_BalloonReleased.data();
+  float *             displacementMagnitudes = m_DisplacementMagnitudes.data();
+  float *             externalMagnitudes = m_ExternalForceMagnitudes.data();
+  float *             internalMagnitudes = m_InternalForceMagnitudes.data();
+
+  // The external forces of a run of vertices first, then the rest: two short
+  // loop bodies whose long dependency chains (index, voxel loads,
+  // interpolation; neighbour loads, normal) overlap across vertices.
+  constexpr SizeValueType run = 32;
+  Vec4                    externalForces[run];
+  double                  largest = 0.0; // squared
+  for (SizeValueType i = begin; i < end; ++i)
+  {
+    if ((i - begin) % run == 0)
+    {
+      const SizeValueType runEnd = std::min(end, i + run);
+      for (SizeValueType j = i; j < runEnd; ++j)
+      {
+        externalForces[j - i] = Splat(scaleFactor) * SampleForce(sampler, Load4(x + 3 * j));
+      }
+    }
+    const Vec4 xi = Load4(x + 3 * i);
+    Vec4       u{};
+    Vec4       n{};
+    Vec4       internal{};
+    if (UseRigidity)
+    {
+      u = Load4(umbrellaField + 4 * i);
+      if (UseNormal)
+      {
+        n = Load4(normalField + 4 * i);
+      }
+      const IndexType32 first = offsets[i];
+      const IndexType32 stop = offsets[i + 1];
+      if (stop > first)
+      {
+        Vec4 mean{};
+        for (IndexType32 k = first; k < stop; ++k)
+        {
+          mean += Load4(umbrellaField + 4 * static_cast<SizeValueType>(neighbours[k]));
+        }
+        internal = Splat(rigidity) * (u - mean * Splat(InverseCount(stop - first)));
+      }
+    }
+    else if (UseNormal)
+    {
+      this->template ComputeGeometry<true>(x, i, u, n);
+    }
+    else if (useElasticity)
+    {
+      this->template ComputeGeometry<false>(x, i, u, n);
+    }
+    if (useElasticity)
+    {
+      const Vec4 e = tangential ? u - Dot4Splat(u, n) * n : u;
+      internal += Splat(elasticity) * e;
+    }
+
+    const Vec4 external = externalForces[(i - begin) % run];
+    // The balloon carries a vertex to an edge, not past it: once the external
+    // force opposes it with half its strength, the vertex is in the edge's
+    // capture range and the balloon is released for it, so that it settles on
+    // the edge itself instead of where the forces balance.
+    double inflation = 0.0;
+    if (UseNormal && balloon != 0.0 && !balloonReleased[i])
+    {
+      if (balloon * Dot3(external, n) <= -0.5 * balloon * balloon)
+      {
+        balloonReleased[i] = 1;
+      }
+      else
+      {
+        inflation = balloon;
+      }
+    }
+    Vec4 delta = external + internal;
+    if (UseNormal)
+    {
+      delta += Splat(inflation) * n;
+    }
+    if (maximumStep > 0.0)
+    {
+      const double length = std::sqrt(Dot3(delta, delta));
+      if (length > maximumStep)
+      {
+        delta *= Splat(maximumStep / length);
+      }
+    }
+    // A 4-wide store spills into the next point's first coordinate, which the
+    // next iteration of this loop overwrites; not at the block's end.
+    if (i + 1 < end)
+    {
+      Store4(next + 3 * i, xi + delta);
+    }
+    else
+    {
+      Store3(next + 3 * i, xi + delta);
+    }
+
+    // Diagnostics, in single precision as they are stored: the three lengths
+    // with one square root. The largest displacement is kept squared.
+    const Vec4 squares = SquaredLengths(delta, external, internal);
+    SqrtStore3(squares, displacementMagnitudes + i, externalMagnitudes + i, internalMagnitudes + i);
+    largest = std::max(largest, squares[0]);
+  }
+  return std::sqrt(largest);
 }
 
 template <typename TMesh, typename TForceImage>
@@ -570,7 +854,8 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "QuietIterations: " << m_QuietIterations << std::endl;
   os << indent << "LastMaximumDisplacement: " << m_LastMaximumDisplacement << std::endl;
   os << indent << "OrientationSign: " << m_OrientationSign << std::endl;
-  os << indent << "Neighbours: " << m_Neighbours.size() << " entries, Triangles: " << m_NumberOfTriangles << std::endl;
+  os << indent << "Neighbours: " << m_Neighbours.size() << " entries, Triangles: " << m_NumberOfTriangles
+     << ", vertices outside a single fan: " << m_GeneralVertices.size() << std::endl;
   os << indent << "ForceBuffer: " << m_ForceBuffer << std::endl;
   os << indent << "PhysicalToIndex: [" << m_PhysicalToIndex[0][0] << ' ' << m_PhysicalToIndex[0][1] << ' '
      << m_PhysicalToIndex[0][2] << "; " << m_PhysicalToIndex[1][0] << ' ' << m_PhysicalToIndex[1][1] << ' '

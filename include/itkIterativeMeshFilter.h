@@ -53,8 +53,9 @@ namespace itk
  * the default VectorContainer-based meshes).
  *
  * Subclasses implement Iterate() on the coordinate cache (GetCoordinates(): a
- * flat array of N * PointDimension doubles in physical units) and may override
- * Reset() and HasConverged().
+ * flat array of N * PointDimension doubles in physical units, followed by one
+ * guard value so that a vector load of a point's coordinates plus one more
+ * value stays inside the array) and may override Reset() and HasConverged().
  *
  * \sa BrownianMeshFilter, DeformableMeshFilter
  * \ingroup ExplicitDeformableModel
@@ -133,7 +134,9 @@ protected:
     return false;
   }
 
-  /** The cached coordinates: N * PointDimension doubles, point after point. */
+  /** The cached coordinates: N * PointDimension doubles, point after point,
+   * then one guard value (0). A subclass that swaps in its own array keeps
+   * that size. */
   std::vector<double> &
   GetCoordinates()
   {
@@ -149,7 +152,7 @@ protected:
   SizeValueType
   GetNumberOfCachedPoints() const
   {
-    return m_Coordinates.size() / PointDimension;
+    return m_NumberOfCachedPoints;
   }
 
   /** Writes the cached coordinates into the output mesh points. */
@@ -173,6 +176,7 @@ private:
   bool                m_Cached{ false };
   ModifiedTimeType    m_CachedInputTime{ 0 };
   std::vector<double> m_Coordinates;
+  SizeValueType       m_NumberOfCachedPoints{ 0 };
 
   // The output's structure and points, reused from one update to the next:
   // cloning the cells at every update costs more than a step on large meshes.

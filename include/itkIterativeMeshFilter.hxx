@@ -70,7 +70,8 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::CacheInput()
   const auto *          points = input->GetPoints();
   const SizeValueType   numberOfPoints = points->Size();
 
-  m_Coordinates.resize(numberOfPoints * PointDimension);
+  m_NumberOfCachedPoints = 0;
+  m_Coordinates.assign(numberOfPoints * PointDimension + 1, 0.0);
   SizeValueType expectedId = 0;
   for (auto it = points->Begin(); it != points->End(); ++it, ++expectedId)
   {
@@ -91,6 +92,7 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::CacheInput()
       m_Coordinates[expectedId * PointDimension + d] = value;
     }
   }
+  m_NumberOfCachedPoints = numberOfPoints;
   m_CachedInputTime = std::max(input->GetMTime(), input->GetUpdateMTime());
 }
 

@@ -28,13 +28,19 @@
 #include "itkDeformableMeshFilter.h"
 #include "itkEllipsoidPhantom.h"
 #include "itkExternalForceImageFilter.h"
+#include "itkLineCell.h"
 #include "itkMesh.h"
+#include "itkQuadrilateralCell.h"
+#include "itkTriangleCell.h"
 
 #include "gtest/gtest.h"
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <set>
+#include <sstream>
 
 namespace
 {
@@ -552,4 +558,204 @@ TEST(InternalForces, DiagnosticsDescribeTheLastIteration)
   filter->Update();
   EXPECT_NEAR(filter->GetOutput()->GetPoint(0)[0] - sphere->GetPoint(0)[0], 0.75, 1e-12);
   EXPECT_DOUBLE_EQ(filter->GetLastMaximumDisplacement(), 0.25);
+}
+
+namespace
+{
+/** One step of Elasticity a (not tangential), Rigidity b and Balloon c
+ * without external force, computed here from the definitions: umbrella u_i =
+ * mean of the edge neighbours minus x_i, rigidity term b (u_i - mean of the
+ * neighbours' u), normal = sum over the vertex's triangles (polygons
+ * fan-triangulated from their first point) of (y - x_i) x (z - x_i), made
+ * unit and outward (the mesh is outward-oriented). */
+std::vector<double>
+ExpectedStep(const MeshType * mesh, double a, double b, double c)
+{
+  const size_t                      n = mesh->GetNumberOfPoints();
+  std::vector<std::set<size_t>>     neighbours(n);
+  std::vector<std::array<double, 3>> normals(n, { 0.0, 0.0, 0.0 });
+  auto point = [mesh](size_t i) { return mesh->GetPoint(i); };
+  for (auto it = mesh->GetCells()->Begin(); it != mesh->GetCells()->End(); ++it)
+  {
+    const auto * ids = it.Value()->PointIdsBegin();
+    const auto   count = it.Value()->GetNumberOfPoints();
+    const bool   closed = count >= 3;
+    for (unsigned int k = 0; k + (closed ? 0 : 1) < count; ++k)
+    {
+      const size_t p = ids[k];
+      const size_t q = ids[(k + 1) % count];
+      neighbours[p].insert(q);
+      neighbours[q].insert(p);
+    }
+    for (unsigned int k = 1; closed && k + 1 < count; ++k)
+    {
+      const size_t corner[3] = { ids[0], ids[k], ids[k + 1] };
+      for (unsigned int m = 0; m < 3; ++m)
+      {
+        const auto x = point(corner[m]);
+        const auto y = point(corner[(m + 1) % 3]) - x;
+        const auto z = point(corner[(m + 2) % 3]) - x;
+        normals[corner[m]][0] += y[1] * z[2] - y[2] * z[1];
+        normals[corner[m]][1] += y[2] * z[0] - y[0] * z[2];
+        normals[corner[m]][2] += y[0] * z[1] - y[1] * z[0];
+      }
+    }
+  }
+  std::vector<double> umbrella(3 * n, 0.0);
+  for (size_t i = 0; i < n; ++i)
+  {
+    for (const size_t j : neighbours[i])
+    {
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        umbrella[3 * i + d] += (point(j)[d] - point(i)[d]) / neighbours[i].size();
+      }
+    }
+  }
+  std::vector<double> moved(3 * n);
+  for (size_t i = 0; i < n; ++i)
+  {
+    const auto & m = normals[i];
+    const double length = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+    for (unsigned int d = 0; d < 3; ++d)
+    {
+      double mean = 0.0;
+      for (const size_t j : neighbours[i])
+      {
+        mean += umbrella[3 * j + d] / neighbours[i].size();
+      }
+      const double rigid = neighbours[i].empty() ? 0.0 : b * (umbrella[3 * i + d] - mean);
+      moved[3 * i + d] = point(i)[d] + a * umbrella[3 * i + d] + rigid + (length > 0.0 ? c * m[d] / length : 0.0);
+    }
+  }
+  return moved;
+}
+
+/** Vertices the filter could not store as a single fan, from its Print(). */
+size_t
+GeneralVertexCount(const FilterType * filter)
+{
+  std::ostringstream os;
+  filter->Print(os);
+  const std::string text = os.str();
+  const std::string key = "vertices outside a single fan: ";
+  const auto        where = text.find(key);
+  return where == std::string::npos ? size_t(-1) : std::stoul(text.substr(where + key.size()));
+}
+} // namespace
+
+/** A mesh of the given points and cells: 2 ids a line, 3 a triangle, 4 a
+ * quadrilateral. */
+MeshType::Pointer
+MakeMesh(const MeshType * points, const std::vector<std::vector<itk::IdentifierType>> & cells)
+{
+  auto mesh = MeshType::New();
+  mesh->SetPoints(const_cast<MeshType::PointsContainer *>(points->GetPoints()));
+  itk::IdentifierType id = 0;
+  for (const auto & ids : cells)
+  {
+    MeshType::CellAutoPointer cell;
+    if (ids.size() == 2)
+    {
+      cell.TakeOwnership(new itk::LineCell<MeshType::CellType>);
+    }
+    else if (ids.size() == 3)
+    {
+      cell.TakeOwnership(new itk::TriangleCell<MeshType::CellType>);
+    }
+    else
+    {
+      cell.TakeOwnership(new itk::QuadrilateralCell<MeshType::CellType>);
+    }
+    cell->SetPointIds(ids.data());
+    mesh->SetCell(id++, cell);
+  }
+  return mesh;
+}
+
+TEST(InternalForces, OneStepMatchesTheDefinitionsOnClosedOpenAndIrregularVertices)
+{
+  PointType center;
+  center.Fill(0.0);
+  const auto                                    sphere = itk::MakeSphereMesh<MeshType>(center, 8.0, 3);
+  std::vector<std::vector<itk::IdentifierType>> triangles;
+  for (auto it = sphere->GetCells()->Begin(); it != sphere->GetCells()->End(); ++it)
+  {
+    const auto * ids = it.Value()->PointIdsBegin();
+    triangles.push_back({ ids[0], ids[1], ids[2] });
+  }
+
+  // Open: the triangles near the north pole removed, a hole with a boundary.
+  std::vector<std::vector<itk::IdentifierType>> open;
+  for (const auto & t : triangles)
+  {
+    if (sphere->GetPoint(t[0])[2] + sphere->GetPoint(t[1])[2] + sphere->GetPoint(t[2])[2] < 3.0 * 7.0)
+    {
+      open.push_back(t);
+    }
+  }
+  ASSERT_LT(open.size(), triangles.size());
+
+  // Irregular: triangles 0 and its neighbour across edge (a, c) merged into a
+  // quadrilateral, triangle 100 repeated (a non-manifold fan) and a line
+  // between two far points (an edge in no triangle).
+  std::vector<std::vector<itk::IdentifierType>> irregular;
+  const auto &                                  t0 = triangles[0];
+  size_t                                        neighbour = 0;
+  itk::IdentifierType                           fourth = 0;
+  for (size_t k = 1; k < triangles.size() && neighbour == 0; ++k)
+  {
+    for (unsigned int m = 0; m < 3; ++m)
+    {
+      if (triangles[k][m] == t0[0] && triangles[k][(m + 1) % 3] == t0[2])
+      {
+        neighbour = k;
+        fourth = triangles[k][(m + 2) % 3];
+      }
+    }
+  }
+  ASSERT_NE(neighbour, 0u);
+  irregular.push_back({ t0[0], t0[1], t0[2], fourth });
+  for (size_t k = 1; k < triangles.size(); ++k)
+  {
+    if (k != neighbour)
+    {
+      irregular.push_back(triangles[k]);
+    }
+  }
+  irregular.push_back(triangles[100]);
+  irregular.push_back({ triangles[200][0], triangles[5][1] });
+
+  const auto field = ZeroForceField();
+  const std::vector<std::vector<itk::IdentifierType>> * cases[] = { &triangles, &open, &irregular };
+  for (const auto * cellsOfCase : cases)
+  {
+    const auto & cells = *cellsOfCase;
+    const auto   mesh = MakeMesh(sphere, cells);
+    for (const double rigidity : { 0.0, 0.2 })
+    {
+      auto filter = FilterType::New();
+      filter->SetInput(mesh);
+      filter->SetForceImage(field);
+      filter->SetElasticity(0.5);
+      filter->TangentialElasticityOff();
+      filter->SetRigidity(rigidity);
+      filter->SetBalloon(0.3);
+      filter->SetNumberOfIterations(1);
+      filter->Update();
+      ASSERT_EQ(filter->GetOrientationSign(), 1.0);
+      const auto expected = ExpectedStep(mesh, 0.5, rigidity, 0.3);
+      double     largestError = 0.0;
+      for (size_t i = 0; i < mesh->GetNumberOfPoints(); ++i)
+      {
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          largestError = std::max(largestError, std::abs(filter->GetOutput()->GetPoint(i)[d] - expected[3 * i + d]));
+        }
+      }
+      EXPECT_LT(largestError, 1e-12) << cells.size() << " cells, rigidity " << rigidity;
+      // Every vertex of the closed and the open mesh lies in a single fan.
+      EXPECT_EQ(GeneralVertexCount(filter) > 0, cellsOfCase == &irregular) << cells.size() << " cells";
+    }
+  }
 }

@@ -1,0 +1,373 @@
+/*=========================================================================
+ *
+ *  Copyright NumFOCUS
+ *
+ *  Licensed under the Apache License, Version 2.0 (the "License");
+ *  you may not use this file except in compliance with the License.
+ *  You may obtain a copy of the License at
+ *
+ *         http://www.apache.org/licenses/LICENSE-2.0.txt
+ *
+ *  Unless required by applicable law or agreed to in writing, software
+ *  distributed under the License is distributed on an "AS IS" BASIS,
+ *  WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+ *  See the License for the specific language governing permissions and
+ *  limitations under the License.
+ *
+ *=========================================================================*/
+#ifndef itkDeformableMeshFilterDetail_h
+#define itkDeformableMeshFilterDetail_h
+
+#include <cmath>
+#include <cstring>
+#include <cstdint>
+#include <type_traits>
+#if defined(__AVX__)
+#  include <immintrin.h>
+#elif defined(__SSE2__)
+#  include <emmintrin.h>
+#endif
+
+namespace itk
+{
+/** Four doubles handled as one value, for the step of DeformableMeshFilter: a
+ * 3-D vector in lanes 0 to 2 and a lane 3 that the arithmetic carries along
+ * and the results clear. With GCC and Clang it is a vector-extension type (one
+ * AVX register, or two SSE registers); elsewhere a plain struct.
+ * \ingroup ExplicitDeformableModel */
+namespace DeformableMeshFilterDetail
+{
+#if defined(__GNUC__) || defined(__clang__)
+#  define EDM_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#  define EDM_ALWAYS_INLINE inline
+#endif
+
+// The vector-extension type where it maps to one AVX register; with SSE
+// alone GCC moves its halves through memory, and plain doubles do better.
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__AVX__)
+#  define EDM_VECTOR_EXTENSIONS 1
+#else
+#  define EDM_VECTOR_EXTENSIONS 0
+#endif
+
+#if EDM_VECTOR_EXTENSIONS
+// Alignment 8: values are loaded from and stored to arrays of doubles at any
+// offset, and objects holding them need no over-aligned allocation.
+typedef double Vec4 __attribute__((vector_size(32), aligned(8)));
+typedef int64_t Vec4Mask __attribute__((vector_size(32), aligned(8)));
+
+EDM_ALWAYS_INLINE Vec4
+Splat(double s)
+{
+  return Vec4{ s, s, s, s };
+}
+
+/** (v1, v2, v0, v3): with it, a x b = Rotate(a * Rotate(b) - Rotate(a) * b). */
+EDM_ALWAYS_INLINE Vec4
+Rotate(const Vec4 & v)
+{
+#  if defined(__clang__)
+  return __builtin_shufflevector(v, v, 1, 2, 0, 3);
+#  else
+  return __builtin_shuffle(v, Vec4Mask{ 1, 2, 0, 3 });
+#  endif
+}
+
+/** (v0, v1, v2, 0). */
+EDM_ALWAYS_INLINE Vec4
+ClearLane3(const Vec4 & v)
+{
+#  if defined(__AVX__)
+  return _mm256_blend_pd(v, _mm256_setzero_pd(), 0x8);
+#  elif defined(__clang__)
+  return __builtin_shufflevector(v, Vec4{}, 0, 1, 2, 4);
+#  else
+  return __builtin_shuffle(v, Vec4{}, Vec4Mask{ 0, 1, 2, 4 });
+#  endif
+}
+
+/** True when lanes 0 to 2 of a lie in [lower, upper). */
+EDM_ALWAYS_INLINE bool
+InsideBox(const Vec4 & a, const Vec4 & lower, const Vec4 & upper)
+{
+  const Vec4Mask inside = (a >= lower) & (a < upper);
+  return (inside[0] & inside[1] & inside[2]) != 0;
+}
+#elif defined(__SSE2__)
+// Two SSE registers: (x, y) and (z, lane 3).
+struct Vec4
+{
+  __m128d lo;
+  __m128d hi;
+  Vec4()
+    : lo(_mm_setzero_pd())
+    , hi(_mm_setzero_pd())
+  {}
+  Vec4(__m128d l, __m128d h)
+    : lo(l)
+    , hi(h)
+  {}
+  Vec4(double a, double b, double c, double d)
+    : lo(_mm_set_pd(b, a))
+    , hi(_mm_set_pd(d, c))
+  {}
+  double
+  operator[](int k) const
+  {
+    const __m128d half = k < 2 ? lo : hi;
+    return (k & 1) ? _mm_cvtsd_f64(_mm_unpackhi_pd(half, half)) : _mm_cvtsd_f64(half);
+  }
+};
+#  define EDM_VEC4_OPERATOR(op, intrinsic)                                                                            \
+    EDM_ALWAYS_INLINE Vec4 operator op(const Vec4 & a, const Vec4 & b)                                                \
+    {                                                                                                                  \
+      return Vec4(intrinsic(a.lo, b.lo), intrinsic(a.hi, b.hi));                                                       \
+    }                                                                                                                  \
+    EDM_ALWAYS_INLINE Vec4 & operator op##=(Vec4 & a, const Vec4 & b) { return a = a op b; }
+EDM_VEC4_OPERATOR(+, _mm_add_pd)
+EDM_VEC4_OPERATOR(-, _mm_sub_pd)
+EDM_VEC4_OPERATOR(*, _mm_mul_pd)
+#  undef EDM_VEC4_OPERATOR
+
+EDM_ALWAYS_INLINE Vec4
+Splat(double s)
+{
+  const __m128d v = _mm_set1_pd(s);
+  return Vec4(v, v);
+}
+
+EDM_ALWAYS_INLINE Vec4
+Rotate(const Vec4 & v)
+{
+  return Vec4(_mm_shuffle_pd(v.lo, v.hi, 1), _mm_shuffle_pd(v.lo, v.hi, 2));
+}
+
+EDM_ALWAYS_INLINE Vec4
+ClearLane3(const Vec4 & v)
+{
+  return Vec4(v.lo, _mm_move_sd(_mm_setzero_pd(), v.hi));
+}
+
+EDM_ALWAYS_INLINE bool
+InsideBox(const Vec4 & a, const Vec4 & lower, const Vec4 & upper)
+{
+  const __m128d low = _mm_and_pd(_mm_cmpge_pd(a.lo, lower.lo), _mm_cmplt_pd(a.lo, upper.lo));
+  const __m128d high = _mm_and_pd(_mm_cmpge_pd(a.hi, lower.hi), _mm_cmplt_pd(a.hi, upper.hi));
+  return _mm_movemask_pd(low) == 3 && (_mm_movemask_pd(high) & 1) == 1;
+}
+#else
+struct Vec4
+{
+  double v[4];
+  double &
+  operator[](int k)
+  {
+    return v[k];
+  }
+  double
+  operator[](int k) const
+  {
+    return v[k];
+  }
+};
+#  define EDM_VEC4_OPERATOR(op)                                                                                       \
+    inline Vec4 operator op(const Vec4 & a, const Vec4 & b)                                                           \
+    {                                                                                                                  \
+      return Vec4{ { a.v[0] op b.v[0], a.v[1] op b.v[1], a.v[2] op b.v[2], a.v[3] op b.v[3] } };                     \
+    }                                                                                                                  \
+    inline Vec4 & operator op##=(Vec4 & a, const Vec4 & b) { return a = a op b; }                                     \
+    inline Vec4 operator op(const Vec4 & a, double s) { return a op Vec4{ { s, s, s, s } }; }                         \
+    inline Vec4 operator op(double s, const Vec4 & a) { return Vec4{ { s, s, s, s } } op a; }
+EDM_VEC4_OPERATOR(+)
+EDM_VEC4_OPERATOR(-)
+EDM_VEC4_OPERATOR(*)
+#  undef EDM_VEC4_OPERATOR
+
+EDM_ALWAYS_INLINE Vec4
+Splat(double s)
+{
+  return Vec4{ { s, s, s, s } };
+}
+
+EDM_ALWAYS_INLINE Vec4
+Rotate(const Vec4 & v)
+{
+  return Vec4{ { v.v[1], v.v[2], v.v[0], v.v[3] } };
+}
+
+EDM_ALWAYS_INLINE Vec4
+ClearLane3(const Vec4 & v)
+{
+  return Vec4{ { v.v[0], v.v[1], v.v[2], 0.0 } };
+}
+
+EDM_ALWAYS_INLINE bool
+InsideBox(const Vec4 & a, const Vec4 & lower, const Vec4 & upper)
+{
+  return a.v[0] >= lower.v[0] && a.v[0] < upper.v[0] && a.v[1] >= lower.v[1] && a.v[1] < upper.v[1] &&
+         a.v[2] >= lower.v[2] && a.v[2] < upper.v[2];
+}
+#endif
+
+/** Four doubles from p (p[3] must be readable). */
+EDM_ALWAYS_INLINE Vec4
+Load4(const double * p)
+{
+#if EDM_VECTOR_EXTENSIONS
+  // A vector type aliases its element type; Vec4 is aligned as a double.
+  return *reinterpret_cast<const Vec4 *>(p);
+#elif defined(__SSE2__)
+  return Vec4(_mm_loadu_pd(p), _mm_loadu_pd(p + 2));
+#else
+  Vec4 v;
+  std::memcpy(&v, p, sizeof(v));
+  return v;
+#endif
+}
+
+EDM_ALWAYS_INLINE void
+Store4(double * p, const Vec4 & v)
+{
+#if EDM_VECTOR_EXTENSIONS
+  *reinterpret_cast<Vec4 *>(p) = v;
+#elif defined(__SSE2__)
+  _mm_storeu_pd(p, v.lo);
+  _mm_storeu_pd(p + 2, v.hi);
+#else
+  std::memcpy(p, &v, sizeof(v));
+#endif
+}
+
+EDM_ALWAYS_INLINE void
+Store3(double * p, const Vec4 & v)
+{
+  p[0] = v[0];
+  p[1] = v[1];
+  p[2] = v[2];
+}
+
+/** Square root of each lane. */
+EDM_ALWAYS_INLINE Vec4
+Sqrt(const Vec4 & v)
+{
+#if defined(__AVX__)
+  return _mm256_sqrt_pd(v);
+#elif defined(__SSE2__) && !EDM_VECTOR_EXTENSIONS
+  return Vec4(_mm_sqrt_pd(v.lo), _mm_sqrt_pd(v.hi));
+#else
+  return Vec4{ std::sqrt(v[0]), std::sqrt(v[1]), std::sqrt(v[2]), std::sqrt(v[3]) };
+#endif
+}
+
+/** 1 / n, from a table for the usual vertex valences. */
+EDM_ALWAYS_INLINE double
+InverseCount(uint32_t n)
+{
+  static constexpr double table[16] = { 0.0,       1.0,       1.0 / 2,  1.0 / 3,  1.0 / 4,  1.0 / 5,
+                                        1.0 / 6,   1.0 / 7,   1.0 / 8,  1.0 / 9,  1.0 / 10, 1.0 / 11,
+                                        1.0 / 12,  1.0 / 13,  1.0 / 14, 1.0 / 15 };
+  return n < 16 ? table[n] : 1.0 / static_cast<double>(n);
+}
+
+/** a . b in every lane; lane 3 of a * b must be 0. */
+EDM_ALWAYS_INLINE Vec4
+Dot4Splat(const Vec4 & a, const Vec4 & b)
+{
+  const Vec4 p = a * b;
+#if defined(__AVX__)
+  const __m256d h = _mm256_hadd_pd(p, p); // (p0+p1, p0+p1, p2+p3, p2+p3)
+  return _mm256_add_pd(h, _mm256_permute2f128_pd(h, h, 1));
+#else
+  return Splat(p[0] + p[1] + p[2] + p[3]);
+#endif
+}
+
+/** Lanes 0 to 2 of a . b. */
+EDM_ALWAYS_INLINE double
+Dot3(const Vec4 & a, const Vec4 & b)
+{
+  const Vec4 p = a * b;
+  return p[0] + p[1] + p[2];
+}
+
+/** (a . a, b . b, c . c, 0); lane 3 of a, b and c must be 0. */
+EDM_ALWAYS_INLINE Vec4
+SquaredLengths(const Vec4 & a, const Vec4 & b, const Vec4 & c)
+{
+#if defined(__AVX__)
+  const __m256d ab = _mm256_hadd_pd(a * a, b * b);             // (a0+a1, b0+b1, a2+a3, b2+b3)
+  const __m256d c0 = _mm256_hadd_pd(c * c, _mm256_setzero_pd()); // (c0+c1, 0, c2+c3, 0)
+  return _mm256_add_pd(_mm256_permute2f128_pd(ab, c0, 0x20), _mm256_permute2f128_pd(ab, c0, 0x31));
+#else
+  return Vec4{ Dot3(a, a), Dot3(b, b), Dot3(c, c), 0.0 };
+#endif
+}
+
+/** Square roots of lanes 0 to 2 of squares into *a, *b and *c, in single
+ * precision. The roots are taken in double precision: squares of small
+ * lengths are subnormal in single precision, whose square roots cost a
+ * hundred cycles or more. */
+EDM_ALWAYS_INLINE void
+SqrtStore3(const Vec4 & squares, float * a, float * b, float * c)
+{
+#if defined(__AVX__)
+  const __m128 r = _mm256_cvtpd_ps(_mm256_sqrt_pd(squares));
+  _mm_store_ss(a, r);
+  *b = _mm_cvtss_f32(_mm_movehdup_ps(r));
+  *c = _mm_cvtss_f32(_mm_movehl_ps(r, r));
+#else
+  *a = static_cast<float>(std::sqrt(squares[0]));
+  *b = static_cast<float>(std::sqrt(squares[1]));
+  *c = static_cast<float>(std::sqrt(squares[2]));
+#endif
+}
+
+/** The 3 components of a force pixel as lanes 0 to 2; lane 3 is whatever
+ * follows them in memory when Padded (the caller guarantees it is readable)
+ * and 0 otherwise. */
+template <typename TPixel, bool Padded>
+struct PixelLoader
+{
+  static Vec4
+  Load(const TPixel & p)
+  {
+    return Vec4{ static_cast<double>(p[0]), static_cast<double>(p[1]), static_cast<double>(p[2]), 0.0 };
+  }
+};
+
+template <typename TPixel>
+struct PixelLoader<TPixel, true>
+{
+  static Vec4
+  Load(const TPixel & p)
+  {
+    using ValueType = typename TPixel::ValueType;
+    if (std::is_same<ValueType, double>::value && sizeof(TPixel) == 3 * sizeof(double))
+    {
+      return Load4(reinterpret_cast<const double *>(&p));
+    }
+#if EDM_VECTOR_EXTENSIONS
+    if (std::is_same<ValueType, float>::value && sizeof(TPixel) == 3 * sizeof(float))
+    {
+#  if defined(__AVX__)
+      return _mm256_cvtps_pd(_mm_loadu_ps(reinterpret_cast<const float *>(&p)));
+#  else
+      typedef float Float4 __attribute__((vector_size(16), aligned(4)));
+      return __builtin_convertvector(*reinterpret_cast<const Float4 *>(&p), Vec4);
+#  endif
+    }
+#elif defined(__SSE2__)
+    if (std::is_same<ValueType, float>::value && sizeof(TPixel) == 3 * sizeof(float))
+    {
+      const __m128 f = _mm_loadu_ps(reinterpret_cast<const float *>(&p));
+      return Vec4(_mm_cvtps_pd(f), _mm_cvtps_pd(_mm_movehl_ps(f, f)));
+    }
+#endif
+    return PixelLoader<TPixel, false>::Load(p);
+  }
+};
+} // namespace DeformableMeshFilterDetail
+} // namespace itk
+
+#endif
