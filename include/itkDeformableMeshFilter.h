@@ -329,10 +329,10 @@ private:
 
   // Per-vertex state. Next coordinates: 3 per vertex and a guard value, as
   // the cached coordinates they are swapped with; umbrella vectors and
-  // normals (rigidity only): 4 per vertex.
+  // normals (rigidity only): 4 floats per vertex.
   std::vector<double>  m_NextCoordinates;
-  std::vector<double>  m_Umbrella;
-  std::vector<double>  m_Normals;
+  std::vector<float>   m_Umbrella;
+  std::vector<float>   m_Normals;
   std::vector<uint8_t> m_BalloonReleased;
   std::vector<float>   m_DisplacementMagnitudes;
   std::vector<float>   m_ExternalForceMagnitudes;

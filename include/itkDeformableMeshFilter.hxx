@@ -483,8 +483,8 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
   // As the cached coordinates: 3 per point and a guard value.
   m_NextCoordinates.assign(3 * numberOfPoints + 1, 0.0);
-  std::vector<double>().swap(m_Umbrella);
-  std::vector<double>().swap(m_Normals);
+  std::vector<float>().swap(m_Umbrella);
+  std::vector<float>().swap(m_Normals);
   m_BalloonReleased.clear();
   m_DisplacementMagnitudes.clear();
   m_ExternalForceMagnitudes.clear();
@@ -525,6 +525,9 @@ DeformableMeshFilter<TMesh, TForceImage>::ComputeGeometry(const double * x, Size
   Vec4       twisted{}; // sum of d_j * R(d_j+1) - R(d_j) * d_j+1; R(twisted) is sum of d_j x d_j+1
   Vec4       previous = first;
   Vec4       previousRotated = firstRotated;
+#if defined(__GNUC__) && !defined(__clang__)
+#  pragma GCC unroll 2
+#endif
   for (IndexType32 k = begin + 1; k < end; ++k)
   {
     const Vec4 d = Load4(x + 3 * static_cast<SizeValueType>(ring[k])) - xi;
@@ -624,15 +627,18 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
 
   // With rigidity, a first pass stores the umbrella vectors (and normals) of
   // all vertices: the rigidity force is the umbrella of the umbrella field.
+  // They are stored in single precision (16 bytes a vector): the pass is
+  // limited by memory traffic, and they enter the step as forces, not as
+  // positions (relative error 6e-8 of the step).
   if (useRigidity)
   {
     if (m_Umbrella.size() != 4 * numberOfPoints)
     {
-      m_Umbrella.assign(4 * numberOfPoints, 0.0);
+      m_Umbrella.assign(4 * numberOfPoints, 0.0f);
     }
     if (useNormal && m_Normals.size() != 4 * numberOfPoints)
     {
-      m_Normals.assign(4 * numberOfPoints, 0.0);
+      m_Normals.assign(4 * numberOfPoints, 0.0f);
     }
     threader->ParallelizeArray(
       0,
@@ -690,17 +696,17 @@ DeformableMeshFilter<TMesh, TForceImage>::GeometryBlock(SizeValueType begin, Siz
 {
   using namespace DeformableMeshFilterDetail;
   const double * x = this->GetCoordinates().data();
-  double *       umbrellaField = m_Umbrella.data();
-  double *       normalField = m_Normals.data();
+  float *        umbrellaField = m_Umbrella.data();
+  float *        normalField = m_Normals.data();
   Vec4           u;
   Vec4           n;
   for (SizeValueType i = begin; i < end; ++i)
   {
     this->template ComputeGeometry<NeedNormal>(x, i, u, n);
-    Store4(umbrellaField + 4 * i, u);
+    StoreFloat4(umbrellaField + 4 * i, u);
     if (NeedNormal)
     {
-      Store4(normalField + 4 * i, n);
+      StoreFloat4(normalField + 4 * i, n);
     }
   }
 }
@@ -725,8 +731,8 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
   const ForceSampler  sampler = m_Sampler;
   const double *      x = this->GetCoordinates().data();
   double *            next = m_NextCoordinates.data();
-  const double *      umbrellaField = m_Umbrella.data();
-  const double *      normalField = m_Normals.data();
+  const float *       umbrellaField = m_Umbrella.data();
+  const float *       normalField = m_Normals.data();
   const IndexType32 * offsets = m_NeighbourOffsets.data();
   const IndexType32 * neighbours = m_Neighbours.data();
   uint8_t *           balloonReleased = m_BalloonReleased.data();
@@ -756,10 +762,10 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
     Vec4       internal{};
     if (UseRigidity)
     {
-      u = Load4(umbrellaField + 4 * i);
+      u = LoadFloat4(umbrellaField + 4 * i);
       if (UseNormal)
       {
-        n = Load4(normalField + 4 * i);
+        n = LoadFloat4(normalField + 4 * i);
       }
       const IndexType32 first = offsets[i];
       const IndexType32 stop = offsets[i + 1];
@@ -768,7 +774,7 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
         Vec4 mean{};
         for (IndexType32 k = first; k < stop; ++k)
         {
-          mean += Load4(umbrellaField + 4 * static_cast<SizeValueType>(neighbours[k]));
+          mean += LoadFloat4(umbrellaField + 4 * static_cast<SizeValueType>(neighbours[k]));
         }
         internal = Splat(rigidity) * (u - mean * Splat(InverseCount(stop - first)));
       }

@@ -247,6 +247,36 @@ Store3(double * p, const Vec4 & v)
   p[2] = v[2];
 }
 
+/** Four floats from p, as doubles. */
+EDM_ALWAYS_INLINE Vec4
+LoadFloat4(const float * p)
+{
+#if defined(__AVX__)
+  return _mm256_cvtps_pd(_mm_loadu_ps(p));
+#elif defined(__SSE2__) && !EDM_VECTOR_EXTENSIONS
+  const __m128 f = _mm_loadu_ps(p);
+  return Vec4(_mm_cvtps_pd(f), _mm_cvtps_pd(_mm_movehl_ps(f, f)));
+#else
+  return Vec4{ p[0], p[1], p[2], p[3] };
+#endif
+}
+
+/** The four lanes of v, rounded to floats, to p. */
+EDM_ALWAYS_INLINE void
+StoreFloat4(float * p, const Vec4 & v)
+{
+#if defined(__AVX__)
+  _mm_storeu_ps(p, _mm256_cvtpd_ps(v));
+#elif defined(__SSE2__) && !EDM_VECTOR_EXTENSIONS
+  _mm_storeu_ps(p, _mm_movelh_ps(_mm_cvtpd_ps(v.lo), _mm_cvtpd_ps(v.hi)));
+#else
+  p[0] = static_cast<float>(v[0]);
+  p[1] = static_cast<float>(v[1]);
+  p[2] = static_cast<float>(v[2]);
+  p[3] = static_cast<float>(v[3]);
+#endif
+}
+
 /** Square root of each lane. */
 EDM_ALWAYS_INLINE Vec4
 Sqrt(const Vec4 & v)
