@@ -140,10 +140,9 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareForceSampler()
   sampler.strideY = m_BufferSize[0];
   sampler.strideZ = m_BufferSize[0] * m_BufferSize[1];
   sampler.lastPixel = m_BufferSize[0] * m_BufferSize[1] * m_BufferSize[2] - 1;
-  sampler.last = Vec4{ static_cast<double>(sampler.lastX),
-                       static_cast<double>(sampler.lastY),
-                       static_cast<double>(sampler.lastZ),
-                       0.0 };
+  sampler.last = Vec4{
+    static_cast<double>(sampler.lastX), static_cast<double>(sampler.lastY), static_cast<double>(sampler.lastZ), 0.0
+  };
   constexpr double pixelBytes = sizeof(ForcePixelType);
   sampler.byteStrides = Vec4{ pixelBytes,
                               pixelBytes * static_cast<double>(sampler.strideY),
@@ -164,22 +163,22 @@ DeformableMeshFilter<TMesh, TForceImage>::SampleForce(const ForceSampler & sampl
   {
     return Vec4{};
   }
-#if defined(__AVX__)
+#if EDM_VECTOR_EXTENSIONS
   if (sampler.smallBuffer)
   {
     // The eight byte offsets, two vectors of four, from the clamped corners.
     const __m256d f = _mm256_floor_pd(c);
     const Vec4    w = c - f;
-    const Vec4    low = _mm256_max_pd(f, _mm256_setzero_pd()) * sampler.byteStrides;       // (x0, y0, z0, 0)
+    const Vec4    low = _mm256_max_pd(f, _mm256_setzero_pd()) * sampler.byteStrides;        // (x0, y0, z0, 0)
     const Vec4    high = _mm256_min_pd(f + Splat(1.0), sampler.last) * sampler.byteStrides; // (x1, y1, z1, 0)
-    const __m256d xz = _mm256_unpacklo_pd(low, high);                                      // (x0, x1, z0, z1)
-    const __m256d yy = _mm256_unpackhi_pd(low, high);                                      // (y0, y1, 0, 0)
+    const __m256d xz = _mm256_unpacklo_pd(low, high);                                       // (x0, x1, z0, z1)
+    const __m256d yy = _mm256_unpackhi_pd(low, high);                                       // (y0, y1, 0, 0)
     const __m256d yz = _mm256_add_pd(_mm256_permute4x64_pd(yy, 0x44), _mm256_permute4x64_pd(xz, 0xfa));
     const __m128i atX0 = _mm256_cvttpd_epi32(_mm256_add_pd(yz, _mm256_permute4x64_pd(xz, 0x00)));
     const __m128i atX1 = _mm256_cvttpd_epi32(_mm256_add_pd(yz, _mm256_permute4x64_pd(xz, 0x55)));
     const char *  bytes = reinterpret_cast<const char *>(sampler.buffer);
     auto          blend = [&](auto load) {
-      auto       at = [bytes](int offset) -> const ForcePixelType & {
+      auto at = [bytes](int offset) -> const ForcePixelType & {
         return *reinterpret_cast<const ForcePixelType *>(bytes + offset);
       };
       const Vec4 p000 = load(at(_mm_cvtsi128_si32(atX0)));
@@ -575,10 +574,10 @@ DeformableMeshFilter<TMesh, TForceImage>::ComputeGeneralGeometry(const double * 
   const double inverseCount = end > begin ? 1.0 / static_cast<double>(end - begin) : 0.0;
   u = Vec4{ s[0] * inverseCount, s[1] * inverseCount, s[2] * inverseCount, 0.0 };
 
-  const auto   rank = static_cast<SizeValueType>(
+  const auto rank = static_cast<SizeValueType>(
     std::lower_bound(m_GeneralVertices.begin(), m_GeneralVertices.end(), static_cast<IndexType32>(i)) -
     m_GeneralVertices.begin());
-  double       normal[3] = { 0.0, 0.0, 0.0 };
+  double normal[3] = { 0.0, 0.0, 0.0 };
   for (IndexType32 k = m_GeneralPairOffsets[rank]; k < m_GeneralPairOffsets[rank + 1]; ++k)
   {
     const double * b = x + 3 * static_cast<SizeValueType>(m_GeneralPairs[2 * k]);
@@ -667,11 +666,13 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
       const SizeValueType end = std::min(numberOfPoints, begin + blockSize);
       if (useRigidity)
       {
-        blockMaximum[block] = useNormal ? this->StepBlock<true, true>(begin, end) : this->StepBlock<true, false>(begin, end);
+        blockMaximum[block] =
+          useNormal ? this->StepBlock<true, true>(begin, end) : this->StepBlock<true, false>(begin, end);
       }
       else
       {
-        blockMaximum[block] = useNormal ? this->StepBlock<false, true>(begin, end) : this->StepBlock<false, false>(begin, end);
+        blockMaximum[block] =
+          useNormal ? this->StepBlock<false, true>(begin, end) : this->StepBlock<false, false>(begin, end);
       }
     },
     nullptr);

@@ -24,7 +24,7 @@
 #include <type_traits>
 #if defined(__AVX__)
 #  include <immintrin.h>
-#elif defined(__SSE2__)
+#elif defined(__SSE2__) || defined(_M_X64) || (defined(_M_IX86_FP) && _M_IX86_FP >= 2)
 #  include <emmintrin.h>
 #endif
 
@@ -43,18 +43,26 @@ namespace DeformableMeshFilterDetail
 #  define EDM_ALWAYS_INLINE inline
 #endif
 
-// The vector-extension type where it maps to one AVX register; with SSE
-// alone GCC moves its halves through memory, and plain doubles do better.
-#if (defined(__GNUC__) || defined(__clang__)) && defined(__AVX__)
+// The vector-extension type where it maps to one AVX register; with SSE2
+// alone GCC moves its halves through memory, and a pair of SSE2 registers
+// does better; elsewhere four plain doubles. EDM_VEC4_PORTABLE forces the
+// plain version (to test it).
+#if !defined(EDM_VEC4_PORTABLE) && (defined(__GNUC__) || defined(__clang__)) && defined(__AVX__)
 #  define EDM_VECTOR_EXTENSIONS 1
 #else
 #  define EDM_VECTOR_EXTENSIONS 0
+#endif
+#if !defined(EDM_VEC4_PORTABLE) && !EDM_VECTOR_EXTENSIONS &&                                                           \
+  (defined(__SSE2__) || defined(_M_X64) || (defined(_M_IX86_FP) && _M_IX86_FP >= 2))
+#  define EDM_VEC4_SSE2 1
+#else
+#  define EDM_VEC4_SSE2 0
 #endif
 
 #if EDM_VECTOR_EXTENSIONS
 // Alignment 8: values are loaded from and stored to arrays of doubles at any
 // offset, and objects holding them need no over-aligned allocation.
-typedef double Vec4 __attribute__((vector_size(32), aligned(8)));
+typedef double  Vec4 __attribute__((vector_size(32), aligned(8)));
 typedef int64_t Vec4Mask __attribute__((vector_size(32), aligned(8)));
 
 EDM_ALWAYS_INLINE Vec4
@@ -78,7 +86,7 @@ Rotate(const Vec4 & v)
 EDM_ALWAYS_INLINE Vec4
 ClearLane3(const Vec4 & v)
 {
-#  if defined(__AVX__)
+#  if EDM_VECTOR_EXTENSIONS
   return _mm256_blend_pd(v, _mm256_setzero_pd(), 0x8);
 #  elif defined(__clang__)
   return __builtin_shufflevector(v, Vec4{}, 0, 1, 2, 4);
@@ -94,7 +102,7 @@ InsideBox(const Vec4 & a, const Vec4 & lower, const Vec4 & upper)
   const Vec4Mask inside = (a >= lower) & (a < upper);
   return (inside[0] & inside[1] & inside[2]) != 0;
 }
-#elif defined(__SSE2__)
+#elif EDM_VEC4_SSE2
 // Two SSE registers: (x, y) and (z, lane 3).
 struct Vec4
 {
@@ -119,12 +127,15 @@ struct Vec4
     return (k & 1) ? _mm_cvtsd_f64(_mm_unpackhi_pd(half, half)) : _mm_cvtsd_f64(half);
   }
 };
-#  define EDM_VEC4_OPERATOR(op, intrinsic)                                                                            \
-    EDM_ALWAYS_INLINE Vec4 operator op(const Vec4 & a, const Vec4 & b)                                                \
+#  define EDM_VEC4_OPERATOR(op, intrinsic)                                                                             \
+    EDM_ALWAYS_INLINE Vec4 operator op(const Vec4 & a, const Vec4 & b)                                                 \
     {                                                                                                                  \
       return Vec4(intrinsic(a.lo, b.lo), intrinsic(a.hi, b.hi));                                                       \
     }                                                                                                                  \
-    EDM_ALWAYS_INLINE Vec4 & operator op##=(Vec4 & a, const Vec4 & b) { return a = a op b; }
+    EDM_ALWAYS_INLINE Vec4 & operator op##=(Vec4 & a, const Vec4 & b)                                                  \
+    {                                                                                                                  \
+      return a = a op b;                                                                                               \
+    }
 EDM_VEC4_OPERATOR(+, _mm_add_pd)
 EDM_VEC4_OPERATOR(-, _mm_sub_pd)
 EDM_VEC4_OPERATOR(*, _mm_mul_pd)
@@ -171,14 +182,15 @@ struct Vec4
     return v[k];
   }
 };
-#  define EDM_VEC4_OPERATOR(op)                                                                                       \
-    inline Vec4 operator op(const Vec4 & a, const Vec4 & b)                                                           \
+#  define EDM_VEC4_OPERATOR(op)                                                                                        \
+    inline Vec4 operator op(const Vec4 & a, const Vec4 & b)                                                            \
     {                                                                                                                  \
-      return Vec4{ { a.v[0] op b.v[0], a.v[1] op b.v[1], a.v[2] op b.v[2], a.v[3] op b.v[3] } };                     \
+      return Vec4{ { a.v[0] op b.v[0], a.v[1] op b.v[1], a.v[2] op b.v[2], a.v[3] op b.v[3] } };                       \
     }                                                                                                                  \
-    inline Vec4 & operator op##=(Vec4 & a, const Vec4 & b) { return a = a op b; }                                     \
-    inline Vec4 operator op(const Vec4 & a, double s) { return a op Vec4{ { s, s, s, s } }; }                         \
-    inline Vec4 operator op(double s, const Vec4 & a) { return Vec4{ { s, s, s, s } } op a; }
+    inline Vec4 & operator op##=(Vec4 & a, const Vec4 & b)                                                             \
+    {                                                                                                                  \
+      return a = a op b;                                                                                               \
+    }
 EDM_VEC4_OPERATOR(+)
 EDM_VEC4_OPERATOR(-)
 EDM_VEC4_OPERATOR(*)
@@ -217,7 +229,7 @@ Load4(const double * p)
 #if EDM_VECTOR_EXTENSIONS
   // A vector type aliases its element type; Vec4 is aligned as a double.
   return *reinterpret_cast<const Vec4 *>(p);
-#elif defined(__SSE2__)
+#elif EDM_VEC4_SSE2
   return Vec4(_mm_loadu_pd(p), _mm_loadu_pd(p + 2));
 #else
   Vec4 v;
@@ -231,7 +243,7 @@ Store4(double * p, const Vec4 & v)
 {
 #if EDM_VECTOR_EXTENSIONS
   *reinterpret_cast<Vec4 *>(p) = v;
-#elif defined(__SSE2__)
+#elif EDM_VEC4_SSE2
   _mm_storeu_pd(p, v.lo);
   _mm_storeu_pd(p + 2, v.hi);
 #else
@@ -251,9 +263,9 @@ Store3(double * p, const Vec4 & v)
 EDM_ALWAYS_INLINE Vec4
 LoadFloat4(const float * p)
 {
-#if defined(__AVX__)
+#if EDM_VECTOR_EXTENSIONS
   return _mm256_cvtps_pd(_mm_loadu_ps(p));
-#elif defined(__SSE2__) && !EDM_VECTOR_EXTENSIONS
+#elif EDM_VEC4_SSE2
   const __m128 f = _mm_loadu_ps(p);
   return Vec4(_mm_cvtps_pd(f), _mm_cvtps_pd(_mm_movehl_ps(f, f)));
 #else
@@ -265,9 +277,9 @@ LoadFloat4(const float * p)
 EDM_ALWAYS_INLINE void
 StoreFloat4(float * p, const Vec4 & v)
 {
-#if defined(__AVX__)
+#if EDM_VECTOR_EXTENSIONS
   _mm_storeu_ps(p, _mm256_cvtpd_ps(v));
-#elif defined(__SSE2__) && !EDM_VECTOR_EXTENSIONS
+#elif EDM_VEC4_SSE2
   _mm_storeu_ps(p, _mm_movelh_ps(_mm_cvtpd_ps(v.lo), _mm_cvtpd_ps(v.hi)));
 #else
   p[0] = static_cast<float>(v[0]);
@@ -281,9 +293,9 @@ StoreFloat4(float * p, const Vec4 & v)
 EDM_ALWAYS_INLINE Vec4
 Sqrt(const Vec4 & v)
 {
-#if defined(__AVX__)
+#if EDM_VECTOR_EXTENSIONS
   return _mm256_sqrt_pd(v);
-#elif defined(__SSE2__) && !EDM_VECTOR_EXTENSIONS
+#elif EDM_VEC4_SSE2
   return Vec4(_mm_sqrt_pd(v.lo), _mm_sqrt_pd(v.hi));
 #else
   return Vec4{ std::sqrt(v[0]), std::sqrt(v[1]), std::sqrt(v[2]), std::sqrt(v[3]) };
@@ -294,9 +306,8 @@ Sqrt(const Vec4 & v)
 EDM_ALWAYS_INLINE double
 InverseCount(uint32_t n)
 {
-  static constexpr double table[16] = { 0.0,       1.0,       1.0 / 2,  1.0 / 3,  1.0 / 4,  1.0 / 5,
-                                        1.0 / 6,   1.0 / 7,   1.0 / 8,  1.0 / 9,  1.0 / 10, 1.0 / 11,
-                                        1.0 / 12,  1.0 / 13,  1.0 / 14, 1.0 / 15 };
+  static constexpr double table[16] = { 0.0,     1.0,     1.0 / 2,  1.0 / 3,  1.0 / 4,  1.0 / 5,  1.0 / 6,  1.0 / 7,
+                                        1.0 / 8, 1.0 / 9, 1.0 / 10, 1.0 / 11, 1.0 / 12, 1.0 / 13, 1.0 / 14, 1.0 / 15 };
   return n < 16 ? table[n] : 1.0 / static_cast<double>(n);
 }
 
@@ -305,7 +316,7 @@ EDM_ALWAYS_INLINE Vec4
 Dot4Splat(const Vec4 & a, const Vec4 & b)
 {
   const Vec4 p = a * b;
-#if defined(__AVX__)
+#if EDM_VECTOR_EXTENSIONS
   const __m256d h = _mm256_hadd_pd(p, p); // (p0+p1, p0+p1, p2+p3, p2+p3)
   return _mm256_add_pd(h, _mm256_permute2f128_pd(h, h, 1));
 #else
@@ -325,8 +336,8 @@ Dot3(const Vec4 & a, const Vec4 & b)
 EDM_ALWAYS_INLINE Vec4
 SquaredLengths(const Vec4 & a, const Vec4 & b, const Vec4 & c)
 {
-#if defined(__AVX__)
-  const __m256d ab = _mm256_hadd_pd(a * a, b * b);             // (a0+a1, b0+b1, a2+a3, b2+b3)
+#if EDM_VECTOR_EXTENSIONS
+  const __m256d ab = _mm256_hadd_pd(a * a, b * b);               // (a0+a1, b0+b1, a2+a3, b2+b3)
   const __m256d c0 = _mm256_hadd_pd(c * c, _mm256_setzero_pd()); // (c0+c1, 0, c2+c3, 0)
   return _mm256_add_pd(_mm256_permute2f128_pd(ab, c0, 0x20), _mm256_permute2f128_pd(ab, c0, 0x31));
 #else
@@ -341,7 +352,7 @@ SquaredLengths(const Vec4 & a, const Vec4 & b, const Vec4 & c)
 EDM_ALWAYS_INLINE void
 SqrtStore3(const Vec4 & squares, float * a, float * b, float * c)
 {
-#if defined(__AVX__)
+#if EDM_VECTOR_EXTENSIONS
   const __m128 r = _mm256_cvtpd_ps(_mm256_sqrt_pd(squares));
   _mm_store_ss(a, r);
   *b = _mm_cvtss_f32(_mm_movehdup_ps(r));
@@ -380,14 +391,14 @@ struct PixelLoader<TPixel, true>
 #if EDM_VECTOR_EXTENSIONS
     if (std::is_same<ValueType, float>::value && sizeof(TPixel) == 3 * sizeof(float))
     {
-#  if defined(__AVX__)
+#  if EDM_VECTOR_EXTENSIONS
       return _mm256_cvtps_pd(_mm_loadu_ps(reinterpret_cast<const float *>(&p)));
 #  else
       typedef float Float4 __attribute__((vector_size(16), aligned(4)));
       return __builtin_convertvector(*reinterpret_cast<const Float4 *>(&p), Vec4);
 #  endif
     }
-#elif defined(__SSE2__)
+#elif EDM_VEC4_SSE2
     if (std::is_same<ValueType, float>::value && sizeof(TPixel) == 3 * sizeof(float))
     {
       const __m128 f = _mm_loadu_ps(reinterpret_cast<const float *>(&p));

@@ -571,10 +571,10 @@ namespace
 std::vector<double>
 ExpectedStep(const MeshType * mesh, double a, double b, double c)
 {
-  const size_t                      n = mesh->GetNumberOfPoints();
-  std::vector<std::set<size_t>>     neighbours(n);
+  const size_t                       n = mesh->GetNumberOfPoints();
+  std::vector<std::set<size_t>>      neighbours(n);
   std::vector<std::array<double, 3>> normals(n, { 0.0, 0.0, 0.0 });
-  auto point = [mesh](size_t i) { return mesh->GetPoint(i); };
+  auto                               point = [mesh](size_t i) { return mesh->GetPoint(i); };
   for (auto it = mesh->GetCells()->Begin(); it != mesh->GetCells()->End(); ++it)
   {
     const auto * ids = it.Value()->PointIdsBegin();
@@ -726,7 +726,7 @@ TEST(InternalForces, OneStepMatchesTheDefinitionsOnClosedOpenAndIrregularVertice
   irregular.push_back(triangles[100]);
   irregular.push_back({ triangles[200][0], triangles[5][1] });
 
-  const auto field = ZeroForceField();
+  const auto                                            field = ZeroForceField();
   const std::vector<std::vector<itk::IdentifierType>> * cases[] = { &triangles, &open, &irregular };
   for (const auto * cellsOfCase : cases)
   {
