@@ -148,6 +148,12 @@ protected:
   GenerateData() override;
 
 private:
+  /** The input as floats, smoothed by a Gaussian of standard deviation Sigma
+   * (physical units): separable, sampled and truncated at 4 Sigma along each
+   * axis, border pixels repeated, threaded over lines and rows of pixels. */
+  typename RealImageType::Pointer
+  Smooth(const InputImageType * input);
+
   /** Central differences of \a image on its buffer, threaded over lines:
    * calls function(offset, derivative) for every pixel, derivative[d] being
    * (v[+1] - v[-1]) / (2 h_d) along axis d (h_d the spacing when

@@ -19,13 +19,11 @@
 #define itkExternalForceImageFilter_hxx
 
 #include "itkExternalForceImageFilter.h"
-#include "itkCastImageFilter.h"
 #include "itkMultiThreaderBase.h"
-#include "itkProgressAccumulator.h"
-#include "itkSmoothingRecursiveGaussianImageFilter.h"
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace itk
 {
@@ -83,32 +81,8 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::GenerateData()
     }
   }
 
-  auto progress = ProgressAccumulator::New();
-  progress->SetMiniPipelineFilter(this);
-
-  using CastType = CastImageFilter<InputImageType, RealImageType>;
-  auto cast = CastType::New();
-  cast->SetInput(input);
-  cast->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
-  progress->RegisterInternalFilter(cast, 0.1f);
-  typename RealImageType::Pointer smoothed;
-  if (m_Sigma > 0.0)
-  {
-    using SmoothingType = SmoothingRecursiveGaussianImageFilter<RealImageType, RealImageType>;
-    auto smoothing = SmoothingType::New();
-    smoothing->SetInput(cast->GetOutput());
-    smoothing->SetSigma(m_Sigma);
-    smoothing->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
-    progress->RegisterInternalFilter(smoothing, 0.3f);
-    smoothing->Update();
-    smoothed = smoothing->GetOutput();
-  }
-  else
-  {
-    cast->Update();
-    smoothed = cast->GetOutput();
-  }
-  smoothed->DisconnectPipeline();
+  typename RealImageType::Pointer smoothed = this->Smooth(input);
+  this->UpdateProgress(0.3f);
 
   // Edge map |grad (G * I)|.
   auto edgeMap = RealImageType::New();
@@ -185,6 +159,158 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::GenerateData()
     }
   }
   this->GraftOutput(field);
+}
+
+template <typename TInputImage, typename TOutputImage>
+auto
+ExternalForceImageFilter<TInputImage, TOutputImage>::Smooth(const InputImageType * input) ->
+  typename RealImageType::Pointer
+{
+  const auto          region = input->GetBufferedRegion();
+  const auto          size = region.GetSize();
+  const SizeValueType numberOfPixels = region.GetNumberOfPixels();
+  auto                makeImage = [&]() {
+    auto image = RealImageType::New();
+    image->CopyInformation(input);
+    image->SetRegions(region);
+    image->Allocate();
+    return image;
+  };
+  MultiThreaderBase * threader = this->GetMultiThreader();
+  threader->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
+  constexpr SizeValueType chunk = 4096;
+  const SizeValueType     numberOfChunks = (numberOfPixels + chunk - 1) / chunk;
+
+  typename RealImageType::Pointer current = makeImage();
+  {
+    const auto * in = input->GetBufferPointer();
+    float *      out = current->GetBufferPointer();
+    threader->ParallelizeArray(
+      0,
+      numberOfChunks,
+      [&](SizeValueType c) {
+        const SizeValueType end = std::min(numberOfPixels, (c + 1) * chunk);
+        for (SizeValueType i = c * chunk; i < end; ++i)
+        {
+          out[i] = static_cast<float>(in[i]);
+        }
+      },
+      nullptr);
+  }
+  if (m_Sigma == 0.0)
+  {
+    return current;
+  }
+
+  // One axis after the other: the image seen as [outer][n][inner], inner the
+  // pixels of the lower axes (contiguous), n the pixels along the axis.
+  typename RealImageType::Pointer other = makeImage();
+  SizeValueType                   inner = 1;
+  for (unsigned int d = 0; d < ImageDimension; ++d)
+  {
+    const SizeValueType n = size[d];
+    const SizeValueType outer = numberOfPixels / (inner * n);
+    const double        sigma = m_Sigma / input->GetSpacing()[d]; // pixels
+    if (n == 1 || !(sigma > 0.0))
+    {
+      inner *= n;
+      continue;
+    }
+    // Sampled Gaussian truncated at 4 sigma, normalised to a unit sum.
+    const auto         radius = static_cast<SizeValueType>(std::ceil(4.0 * sigma));
+    std::vector<float> weights(radius + 1);
+    double             sum = 0.0;
+    for (SizeValueType k = 0; k <= radius; ++k)
+    {
+      const double w = std::exp(-0.5 * static_cast<double>(k * k) / (sigma * sigma));
+      weights[k] = static_cast<float>(w);
+      sum += k == 0 ? w : 2.0 * w;
+    }
+    for (float & w : weights)
+    {
+      w = static_cast<float>(w / sum);
+    }
+    const float * src = current->GetBufferPointer();
+    float *       dst = other->GetBufferPointer();
+    // Border pixels repeated beyond the image (zero flux).
+    auto clamped = [n](SizeValueType p, SizeValueType k, bool up) -> SizeValueType {
+      return up ? std::min(p + k, n - 1) : (p >= k ? p - k : 0);
+    };
+    if (inner == 1)
+    {
+      threader->ParallelizeArray(
+        0,
+        outer,
+        [&](SizeValueType line) {
+          const float * in = src + line * n;
+          float *       out = dst + line * n;
+          // Interior [first, last): no clamping, vectorisable loops.
+          const SizeValueType first = n > 2 * radius ? radius : n;
+          const SizeValueType last = n > 2 * radius ? n - radius : n;
+          auto                border = [&](SizeValueType p) {
+            float value = weights[0] * in[p];
+            for (SizeValueType k = 1; k <= radius; ++k)
+            {
+              value += weights[k] * (in[clamped(p, k, false)] + in[clamped(p, k, true)]);
+            }
+            out[p] = value;
+          };
+          for (SizeValueType p = 0; p < first; ++p)
+          {
+            border(p);
+          }
+          for (SizeValueType p = last; p < n; ++p)
+          {
+            border(p);
+          }
+          for (SizeValueType p = first; p < last; ++p)
+          {
+            out[p] = weights[0] * in[p];
+          }
+          for (SizeValueType k = 1; k <= radius; ++k)
+          {
+            const float w = weights[k];
+            for (SizeValueType p = first; p < last; ++p)
+            {
+              out[p] += w * (in[p - k] + in[p + k]);
+            }
+          }
+        },
+        nullptr);
+    }
+    else
+    {
+      threader->ParallelizeArray(
+        0,
+        outer * n,
+        [&](SizeValueType row) {
+          const SizeValueType o = row / n;
+          const SizeValueType p = row % n;
+          const float *       base = src + o * n * inner;
+          float *             out = dst + row * inner;
+          const float *       centre = base + p * inner;
+          const float         w0 = weights[0];
+          for (SizeValueType i = 0; i < inner; ++i)
+          {
+            out[i] = w0 * centre[i];
+          }
+          for (SizeValueType k = 1; k <= radius; ++k)
+          {
+            const float * below = base + clamped(p, k, false) * inner;
+            const float * above = base + clamped(p, k, true) * inner;
+            const float   w = weights[k];
+            for (SizeValueType i = 0; i < inner; ++i)
+            {
+              out[i] += w * (below[i] + above[i]);
+            }
+          }
+        },
+        nullptr);
+    }
+    std::swap(current, other);
+    inner *= n;
+  }
+  return current;
 }
 
 template <typename TInputImage, typename TOutputImage>
