@@ -33,15 +33,18 @@ namespace itk
  * sampling this field pulls its vertices onto the boundary.
  *
  * Steps, all in physical space (origin, spacing and direction honoured):
- * -# Gaussian smoothing of standard deviation Sigma (physical units; 0 skips it);
+ * -# Gaussian smoothing of standard deviation Sigma (physical units; 0 skips
+ *    it): separable, the Gaussian sampled and truncated at 4 Sigma along each
+ *    axis and normalised, border pixels repeated beyond the image;
  * -# edge map \f$ e = |\nabla (G_\sigma * I)| \f$;
  * -# force \f$ F = \nabla e \f$.
  *
  * Both derivatives are central differences with a zero-flux boundary, as
  * GradientImageFilter computes them, honouring the inherited UseImageSpacing
- * and UseImageDirection (both On by default); they run on the raw buffers,
- * threaded over image lines, which is 1.2 to 1.9 times faster than two
- * GradientImageFilter passes (OverrideBoundaryCondition does not apply).
+ * and UseImageDirection (both On by default). Smoothing and derivatives run
+ * on the raw buffers, threaded over rows of pixels: the whole filter is
+ * faster per voxel than two GradientImageFilter passes (OverrideBoundaryCondition
+ * does not apply).
  * Then:
  * -# with UseGradientVectorFlow, the gradient vector flow of Xu and Prince:
  *    \f$ \partial_t v = \mu \nabla^2 v - |\nabla e|^2 (v - \nabla e) \f$ iterated
