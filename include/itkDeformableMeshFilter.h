@@ -187,7 +187,11 @@ public:
   /** Per-vertex diagnostics of the last iteration, indexed by point
    * identifier, physical units: displacement length, external force
    * contribution s|F| and internal force contribution |aE + bR|. Empty before
-   * the first iteration. */
+   * the first iteration. They are computed at the iterations that may end an
+   * update (the last one scheduled, one that can complete convergence) and at
+   * every iteration when the filter has an IterationEvent or ProgressEvent
+   * observer; an update stopped otherwise (AbortGenerateData set by another
+   * thread) leaves those of an earlier iteration. */
   const std::vector<float> &
   GetDisplacementMagnitudes() const
   {
@@ -295,7 +299,7 @@ private:
   /** The step of vertices [begin, end); returns their largest displacement. */
   template <bool UseRigidity, bool UseNormal>
   double
-  StepBlock(SizeValueType begin, SizeValueType end);
+  StepBlock(SizeValueType begin, SizeValueType end, bool diagnose);
 
   /** ComputeGeometry() for a GeneralVertex. */
   void

@@ -618,6 +618,14 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   {
     m_BalloonReleased.assign(numberOfPoints, 0);
   }
+  // The diagnostics describe the last iteration of an update: they are
+  // computed when this iteration may be the last (the last one scheduled, or
+  // one that can complete convergence) and at every iteration when an
+  // observer may look at them or stop the update (IterationEvent,
+  // ProgressEvent). Elsewhere they would cost about a tenth of the step.
+  const bool diagnose = this->GetCurrentIteration() + 1 >= this->GetNumberOfIterations() ||
+                        (m_ConvergenceTolerance > 0.0 && m_QuietIterations + 1 >= m_ConvergenceWindow) ||
+                        this->HasObserver(IterationEvent()) || this->HasObserver(ProgressEvent());
 
   constexpr SizeValueType blockSize = 2048;
   const SizeValueType     numberOfBlocks = (numberOfPoints + blockSize - 1) / blockSize;
@@ -661,18 +669,18 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   threader->ParallelizeArray(
     0,
     numberOfBlocks,
-    [this, numberOfPoints, useRigidity, useNormal, &blockMaximum](SizeValueType block) {
+    [this, numberOfPoints, useRigidity, useNormal, diagnose, &blockMaximum](SizeValueType block) {
       const SizeValueType begin = block * blockSize;
       const SizeValueType end = std::min(numberOfPoints, begin + blockSize);
       if (useRigidity)
       {
-        blockMaximum[block] =
-          useNormal ? this->StepBlock<true, true>(begin, end) : this->StepBlock<true, false>(begin, end);
+        blockMaximum[block] = useNormal ? this->StepBlock<true, true>(begin, end, diagnose)
+                                        : this->StepBlock<true, false>(begin, end, diagnose);
       }
       else
       {
-        blockMaximum[block] =
-          useNormal ? this->StepBlock<false, true>(begin, end) : this->StepBlock<false, false>(begin, end);
+        blockMaximum[block] = useNormal ? this->StepBlock<false, true>(begin, end, diagnose)
+                                        : this->StepBlock<false, false>(begin, end, diagnose);
       }
     },
     nullptr);
@@ -715,7 +723,7 @@ DeformableMeshFilter<TMesh, TForceImage>::GeometryBlock(SizeValueType begin, Siz
 template <typename TMesh, typename TForceImage>
 template <bool UseRigidity, bool UseNormal>
 double
-DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeValueType end)
+DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeValueType end, bool diagnose)
 {
   using namespace DeformableMeshFilterDetail;
   // Everything the loop reads, in locals: the compiler cannot keep members in
@@ -837,9 +845,16 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
 
     // Diagnostics, in single precision as they are stored: the three lengths
     // with one square root. The largest displacement is kept squared.
-    const Vec4 squares = SquaredLengths(delta, external, internal);
-    SqrtStore3(squares, displacementMagnitudes + i, externalMagnitudes + i, internalMagnitudes + i);
-    largest = std::max(largest, squares[0]);
+    if (diagnose)
+    {
+      const Vec4 squares = SquaredLengths(delta, external, internal);
+      SqrtStore3(squares, displacementMagnitudes + i, externalMagnitudes + i, internalMagnitudes + i);
+      largest = std::max(largest, squares[0]);
+    }
+    else
+    {
+      largest = std::max(largest, Dot3(delta, delta));
+    }
   }
   return std::sqrt(largest);
 }

@@ -28,6 +28,7 @@
 #include "itkDeformableMeshFilter.h"
 #include "itkEllipsoidPhantom.h"
 #include "itkExternalForceImageFilter.h"
+#include "itkImageRegionIteratorWithIndex.h"
 #include "itkLineCell.h"
 #include "itkMesh.h"
 #include "itkQuadrilateralCell.h"
@@ -760,4 +761,73 @@ TEST(InternalForces, OneStepMatchesTheDefinitionsOnClosedOpenAndIrregularVertice
       EXPECT_EQ(GeneralVertexCount(filter) > 0, cellsOfCase == &irregular) << cells.size() << " cells";
     }
   }
+}
+
+TEST(InternalForces, DiagnosticsAreTheSameWhateverObservesTheFilter)
+{
+  PointType center;
+  center.Fill(0.0);
+  const auto sphere = itk::MakeSphereMesh<MeshType>(center, 8.0, 3);
+  // A field pulling toward the origin, growing with the distance.
+  auto field = ZeroForceField();
+  for (itk::ImageRegionIteratorWithIndex<ForceImageType> it(field, field->GetBufferedRegion()); !it.IsAtEnd(); ++it)
+  {
+    ForceImageType::PointType p;
+    field->TransformIndexToPhysicalPoint(it.GetIndex(), p);
+    ForceImageType::PixelType f;
+    for (unsigned int d = 0; d < 3; ++d)
+    {
+      f[d] = static_cast<float>(-0.05 * p[d]);
+    }
+    it.Set(f);
+  }
+  auto make = [&]() {
+    auto filter = FilterType::New();
+    filter->SetInput(sphere);
+    filter->SetForceImage(field);
+    filter->SetElasticity(0.3);
+    filter->SetRigidity(0.1);
+    filter->SetBalloon(0.05);
+    return filter;
+  };
+  auto diagnostics = [](const FilterType * filter) {
+    return std::vector<std::vector<float>>{ filter->GetDisplacementMagnitudes(),
+                                            filter->GetExternalForceMagnitudes(),
+                                            filter->GetInternalForceMagnitudes() };
+  };
+
+  auto plain = make();
+  plain->SetNumberOfIterations(7);
+  plain->Update();
+  const auto expected = diagnostics(plain);
+  ASSERT_EQ(expected[0].size(), sphere->GetNumberOfPoints());
+  EXPECT_GT(*std::max_element(expected[1].begin(), expected[1].end()), 0.0f);
+  EXPECT_GT(*std::max_element(expected[2].begin(), expected[2].end()), 0.0f);
+
+  auto observed = make();
+  observed->AddObserver(itk::IterationEvent(), [](const itk::EventObject &) {});
+  observed->SetNumberOfIterations(7);
+  observed->Update();
+  EXPECT_EQ(diagnostics(observed), expected);
+
+  auto resumed = make();
+  resumed->SetIterateFromZero(false);
+  resumed->SetNumberOfIterations(3);
+  resumed->Update();
+  resumed->SetNumberOfIterations(7);
+  resumed->Update();
+  EXPECT_EQ(diagnostics(resumed), expected);
+
+  // Convergence ends the update early: the diagnostics are those of the
+  // iteration it stopped at.
+  auto converging = make();
+  converging->SetConvergenceTolerance(10.0);
+  converging->SetConvergenceWindow(2);
+  converging->SetNumberOfIterations(7);
+  converging->Update();
+  ASSERT_TRUE(converging->GetConverged());
+  auto reference = make();
+  reference->SetNumberOfIterations(converging->GetCurrentIteration());
+  reference->Update();
+  EXPECT_EQ(diagnostics(converging), diagnostics(reference));
 }
