@@ -67,15 +67,22 @@ namespace itk
  * and CurrentIteration tells where it stopped. NumberOfIterations remains the
  * cap.
  *
- * The step runs on flat arrays unpacked once in Reset(): coordinates, a CSR
- * vertex-neighbour table and a vertex-triangle table; the force image is read
- * through its buffer with the physical-to-index transform precomputed. Vertices
- * are processed in fixed blocks over threads, so the output is bit-for-bit
+ * The step runs on flat arrays unpacked once in Reset(): coordinates and a CSR
+ * vertex-neighbour table in which the neighbours of a vertex whose triangles
+ * form one fan are stored in fan order, so that the same loads give its
+ * umbrella vector and its normal (sum of (x_j - x_i) x (x_j+1 - x_i)); other
+ * vertices (polygons, lines, non-manifold fans) keep their triangles in a side
+ * table. The force image is read through its buffer with the
+ * physical-to-index transform precomputed. The arithmetic works on 3-D vectors
+ * held in 4 lanes (AVX when the compiler targets it, else SSE2, else plain
+ * doubles). With rigidity, a first pass stores the umbrella vectors and normals
+ * in single precision, the second computes the displacements. Vertices are
+ * processed in fixed blocks over threads, so the output is bit-for-bit
  * identical whatever the number of threads.
  *
- * Per-vertex diagnostics of the last iteration (displacement length, external
- * and internal force lengths, physical units) are available with
- * GetDisplacementMagnitudes(), GetExternalForceMagnitudes() and
+ * Per-vertex diagnostics of the last iteration of an update (displacement
+ * length, external and internal force lengths, physical units) are available
+ * with GetDisplacementMagnitudes(), GetExternalForceMagnitudes() and
  * GetInternalForceMagnitudes().
  *
  * \sa ExternalForceImageFilter, IterativeMeshFilter
