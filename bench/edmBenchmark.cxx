@@ -44,6 +44,7 @@
 #include "itkGradientImageFilter.h"
 #include "itkMesh.h"
 #include "itkMultiThreaderBase.h"
+#include "itkThreadPool.h"
 #include "itkSimplexMesh.h"
 #include "itkTriangleCell.h"
 #include "itkTriangleMeshToSimplexMeshFilter.h"
@@ -357,12 +358,22 @@ SizeLabel(int64_t vertices)
   return vertices >= 1000000 ? "1M" : (vertices >= 100000 ? "100k" : "10k");
 }
 
+/** The global default number of threads while a benchmark runs. ITK's thread
+ * pool is created at its first use with the global default of that moment, and
+ * a PoolMultiThreader takes its maximum number of threads from the pool's
+ * size: a pool created inside a 1-thread scope would leave every later
+ * filter on one thread. The pool is grown here to the requested size first. */
 class ThreadScope
 {
 public:
   explicit ThreadScope(unsigned int threads)
     : m_Saved(itk::MultiThreaderBase::GetGlobalDefaultNumberOfThreads())
   {
+    auto * pool = itk::ThreadPool::GetInstance().GetPointer();
+    if (pool->GetMaximumNumberOfThreads() < threads)
+    {
+      pool->AddThreads(threads - pool->GetMaximumNumberOfThreads());
+    }
     itk::MultiThreaderBase::SetGlobalDefaultNumberOfThreads(threads);
   }
   ~ThreadScope() { itk::MultiThreaderBase::SetGlobalDefaultNumberOfThreads(m_Saved); }
