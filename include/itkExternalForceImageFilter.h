@@ -157,6 +157,19 @@ private:
   typename RealImageType::Pointer
   Smooth(const InputImageType * input);
 
+  using SizeType = typename RealImageType::SizeType;
+
+  /** Start (buffer offset) of line number \a line of pixels along x, and the
+   * offsets from a pixel of that line to its lower and upper neighbours along
+   * the other axes: 0 at the border, so that a missing neighbour is the pixel
+   * itself (zero-flux boundary). lower[0] and upper[0] are left to the caller. */
+  static OffsetValueType
+  LocateLine(SizeValueType    line,
+             const SizeType & size,
+             const OffsetValueType (&stride)[ImageDimension],
+             OffsetValueType (&lower)[ImageDimension],
+             OffsetValueType (&upper)[ImageDimension]);
+
   /** Central differences of \a image on its buffer, threaded over lines:
    * calls function(offset, derivative) for every pixel, derivative[d] being
    * (v[+1] - v[-1]) / (2 h_d) along axis d (h_d the spacing when

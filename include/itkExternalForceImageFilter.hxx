@@ -314,6 +314,26 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::Smooth(const InputImageType
 }
 
 template <typename TInputImage, typename TOutputImage>
+OffsetValueType
+ExternalForceImageFilter<TInputImage, TOutputImage>::LocateLine(SizeValueType    line,
+                                                                const SizeType & size,
+                                                                const OffsetValueType (&stride)[ImageDimension],
+                                                                OffsetValueType (&lower)[ImageDimension],
+                                                                OffsetValueType (&upper)[ImageDimension])
+{
+  OffsetValueType start = 0;
+  for (unsigned int d = 1; d < ImageDimension; ++d)
+  {
+    const SizeValueType coordinate = line % size[d];
+    line /= size[d];
+    start += static_cast<OffsetValueType>(coordinate) * stride[d];
+    lower[d] = coordinate > 0 ? -stride[d] : 0;
+    upper[d] = coordinate + 1 < size[d] ? stride[d] : 0;
+  }
+  return start;
+}
+
+template <typename TInputImage, typename TOutputImage>
 template <typename TFunction>
 void
 ExternalForceImageFilter<TInputImage, TOutputImage>::ForEachCentralDifference(const RealImageType * image,
@@ -343,21 +363,11 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::ForEachCentralDifference(co
     0,
     numberOfLines,
     [&](SizeValueType line) {
-      // Offsets of the lower and upper neighbours along each axis; zero at the
-      // border (zero-flux Neumann condition, as GradientImageFilter's default).
-      SizeValueType   remainder = line;
-      OffsetValueType lineStart = 0;
-      OffsetValueType lower[ImageDimension];
-      OffsetValueType upper[ImageDimension];
-      for (unsigned int d = 1; d < ImageDimension; ++d)
-      {
-        const SizeValueType coordinate = remainder % size[d];
-        remainder /= size[d];
-        lineStart += static_cast<OffsetValueType>(coordinate) * stride[d];
-        lower[d] = coordinate > 0 ? -stride[d] : 0;
-        upper[d] = coordinate + 1 < size[d] ? stride[d] : 0;
-      }
-      double derivative[ImageDimension];
+      // Zero-flux (Neumann) border, as GradientImageFilter's default.
+      OffsetValueType       lower[ImageDimension];
+      OffsetValueType       upper[ImageDimension];
+      const OffsetValueType lineStart = LocateLine(line, size, stride, lower, upper);
+      double                derivative[ImageDimension];
       for (SizeValueType x = 0; x < lineLength; ++x)
       {
         const OffsetValueType i = lineStart + static_cast<OffsetValueType>(x);
@@ -428,34 +438,24 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::DiffuseGradientVectorFlow(O
       0,
       numberOfLines,
       [&](SizeValueType line) {
-        // Position of the line along the axes other than x.
-        SizeValueType   remainder = line;
-        OffsetValueType lineStart = 0;
-        bool            hasLower[ImageDimension];
-        bool            hasUpper[ImageDimension];
-        for (unsigned int d = 1; d < ImageDimension; ++d)
-        {
-          const SizeValueType coordinate = remainder % size[d];
-          remainder /= size[d];
-          lineStart += static_cast<OffsetValueType>(coordinate) * stride[d];
-          hasLower[d] = coordinate > 0;
-          hasUpper[d] = coordinate + 1 < size[d];
-        }
+        // Zero-flux (Neumann) boundary: a missing neighbour equals the centre.
+        OffsetValueType       lower[ImageDimension];
+        OffsetValueType       upper[ImageDimension];
+        const OffsetValueType lineStart = LocateLine(line, size, stride, lower, upper);
         for (SizeValueType x = 0; x < lineLength; ++x)
         {
           const OffsetValueType   i = lineStart + static_cast<OffsetValueType>(x);
           const OutputPixelType & center = v[i];
-          hasLower[0] = x > 0;
-          hasUpper[0] = x + 1 < lineLength;
+          lower[0] = x > 0 ? -1 : 0;
+          upper[0] = x + 1 < lineLength ? 1 : 0;
           double laplacian[Components] = {};
           for (unsigned int d = 0; d < ImageDimension; ++d)
           {
-            // Zero-flux (Neumann) boundary: a missing neighbour equals the centre.
-            const OutputPixelType & lower = hasLower[d] ? v[i - stride[d]] : center;
-            const OutputPixelType & upper = hasUpper[d] ? v[i + stride[d]] : center;
+            const OutputPixelType & below = v[i + lower[d]];
+            const OutputPixelType & above = v[i + upper[d]];
             for (unsigned int k = 0; k < Components; ++k)
             {
-              laplacian[k] += (static_cast<double>(lower[k]) + upper[k] - 2.0 * center[k]) * inverseSquaredSpacing[d];
+              laplacian[k] += (static_cast<double>(below[k]) + above[k] - 2.0 * center[k]) * inverseSquaredSpacing[d];
             }
           }
           for (unsigned int k = 0; k < Components; ++k)
