@@ -178,15 +178,19 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::UpdateOutputPoints()
     m_OutputPoints->Reserve(numberOfPoints);
   }
   OutputPointsContainer * points = m_OutputPoints;
-  const double *          x = m_Coordinates.data();
+  // Through the STL container: ElementAt() calls Modified() for every point,
+  // which costs as much as a step of DeformableMeshFilter on large meshes.
+  auto &         elements = points->CastToSTLContainer();
+  const double * x = m_Coordinates.data();
   for (SizeValueType i = 0; i < numberOfPoints; ++i, x += PointDimension)
   {
-    OutputPointType & p = points->ElementAt(i);
+    OutputPointType & p = elements[i];
     for (unsigned int d = 0; d < PointDimension; ++d)
     {
       p[d] = static_cast<typename OutputPointType::ValueType>(x[d]);
     }
   }
+  points->Modified();
   output->SetPoints(points);
 }
 
