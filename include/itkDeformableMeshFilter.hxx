@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace itk
 {
@@ -376,58 +377,66 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology()
   m_GeneralVertices.clear();
   m_GeneralPairOffsets.assign(1, 0);
   m_GeneralPairs.clear();
-  std::vector<IndexType32> ring;
-  std::vector<IndexType32> sortedRing;
-  std::vector<IndexType32> sortedNeighbours;
-  std::vector<uint8_t>     used;
+  std::vector<IndexType32>                         ring;
+  std::vector<IndexType32>                         sortedRing;
+  std::vector<IndexType32>                         sortedNeighbours;
+  std::vector<std::pair<IndexType32, IndexType32>> fan;  // pairs sorted by b
+  std::vector<IndexType32>                         ends; // the c of the pairs, sorted
   for (SizeValueType i = 0; i < numberOfPoints; ++i)
   {
     const IndexType32 * vertexPairs = pairs.data() + 2 * static_cast<SizeValueType>(pairOffsets[i]);
     const IndexType32   numberOfPairs = pairOffsets[i + 1] - pairOffsets[i];
     const IndexType32   numberOfNeighbours = m_NeighbourOffsets[i + 1] - m_NeighbourOffsets[i];
     RingKind            kind = GeneralVertex;
+    fan.clear();
+    ends.clear();
+    for (IndexType32 p = 0; p < numberOfPairs; ++p)
+    {
+      fan.emplace_back(vertexPairs[2 * p], vertexPairs[2 * p + 1]);
+      ends.push_back(vertexPairs[2 * p + 1]);
+    }
+    std::sort(fan.begin(), fan.end());
+    std::sort(ends.begin(), ends.end());
+    const auto sameFirst = [](const std::pair<IndexType32, IndexType32> & a,
+                              const std::pair<IndexType32, IndexType32> & b) { return a.first == b.first; };
+    // In one fan every neighbour begins at most one pair and ends at most one.
+    const bool oneFanPossible = std::adjacent_find(fan.begin(), fan.end(), sameFirst) == fan.end() &&
+                                std::adjacent_find(ends.begin(), ends.end()) == ends.end();
     if (numberOfNeighbours == 0)
     {
       kind = ClosedRing; // isolated vertex: no umbrella, no normal
     }
-    else if (numberOfPairs > 0)
+    else if (numberOfPairs > 0 && oneFanPossible)
     {
       // Start at a pair whose b ends no other pair (a boundary fan), if any.
       IndexType32 start = 0;
       unsigned    boundaryStarts = 0;
       for (IndexType32 p = 0; p < numberOfPairs; ++p)
       {
-        bool ended = false;
-        for (IndexType32 q = 0; q < numberOfPairs && !ended; ++q)
-        {
-          ended = vertexPairs[2 * q + 1] == vertexPairs[2 * p];
-        }
-        if (!ended)
+        if (!std::binary_search(ends.begin(), ends.end(), fan[p].first))
         {
           start = p;
           ++boundaryStarts;
         }
       }
-      used.assign(numberOfPairs, 0);
-      ring.assign(1, vertexPairs[2 * start]);
-      used[start] = 1;
-      IndexType32 last = vertexPairs[2 * start + 1];
+      // Follow the pairs: c of one is b of the next. With distinct b and c the
+      // walk can only come back to where it started.
+      ring.assign(1, fan[start].first);
+      IndexType32 last = fan[start].second;
       IndexType32 chained = 1;
-      for (bool found = true; found && chained < numberOfPairs;)
+      while (chained < numberOfPairs && last != ring.front())
       {
-        found = false;
-        for (IndexType32 q = 0; q < numberOfPairs; ++q)
+        const auto next = std::lower_bound(fan.begin(),
+                                           fan.end(),
+                                           std::make_pair(last, IndexType32{ 0 }),
+                                           [](const auto & a, const auto & b) { return a.first < b.first; });
+        if (next == fan.end() || next->first != last)
         {
-          if (!used[q] && vertexPairs[2 * q] == last)
-          {
-            ring.push_back(last);
-            used[q] = 1;
-            last = vertexPairs[2 * q + 1];
-            ++chained;
-            found = true;
-            break;
-          }
+          break;
         }
+        ring.push_back(last);
+        last = next->second;
+        ++chained;
       }
       RingKind candidate = ClosedRing;
       if (last != ring.front())

@@ -831,3 +831,41 @@ TEST(InternalForces, DiagnosticsAreTheSameWhateverObservesTheFilter)
   reference->Update();
   EXPECT_EQ(diagnostics(converging), diagnostics(reference));
 }
+
+TEST(InternalForces, BalloonMovesAFlatDiskAlongItsNormalWhateverTheValence)
+{
+  // A flat disk in z = 2: a centre joined to 20 000 rim points (one fan of
+  // 20 000 triangles around the centre, two triangles at each rim point).
+  // The balloon alone moves every point by 0.1 along z, the same way.
+  constexpr unsigned int rim = 20000;
+  auto                   disk = MeshType::New();
+  disk->SetPoint(0, PointType(std::array<double, 3>{ { 0.0, 0.0, 2.0 } }.data()));
+  for (unsigned int k = 0; k < rim; ++k)
+  {
+    const double angle = 6.283185307179586 * k / rim;
+    disk->SetPoint(k + 1,
+                   PointType(std::array<double, 3>{ { 10.0 * std::cos(angle), 10.0 * std::sin(angle), 2.0 } }.data()));
+  }
+  std::vector<std::vector<itk::IdentifierType>> triangles;
+  for (unsigned int k = 0; k < rim; ++k)
+  {
+    triangles.push_back({ 0, k + 1, (k + 1) % rim + 1 });
+  }
+  const auto mesh = MakeMesh(disk, triangles);
+  auto       filter = FilterType::New();
+  filter->SetInput(mesh);
+  filter->SetForceImage(ZeroForceField());
+  filter->SetBalloon(0.1);
+  filter->SetNumberOfIterations(1);
+  filter->Update();
+  EXPECT_EQ(GeneralVertexCount(filter), 0u);
+  const double direction = filter->GetOutput()->GetPoint(0)[2] - 2.0;
+  EXPECT_NEAR(std::abs(direction), 0.1, 1e-12);
+  for (itk::IdentifierType i = 0; i <= rim; ++i)
+  {
+    const auto moved = filter->GetOutput()->GetPoint(i) - mesh->GetPoint(i);
+    ASSERT_NEAR(moved[0], 0.0, 1e-12) << "point " << i;
+    ASSERT_NEAR(moved[1], 0.0, 1e-12) << "point " << i;
+    ASSERT_NEAR(moved[2], direction, 1e-12) << "point " << i;
+  }
+}
