@@ -636,7 +636,7 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
                         (m_ConvergenceTolerance > 0.0 && m_QuietIterations + 1 >= m_ConvergenceWindow) ||
                         this->HasObserver(IterationEvent()) || this->HasObserver(ProgressEvent());
 
-  constexpr SizeValueType blockSize = 2048;
+  constexpr SizeValueType blockSize = 512;
   const SizeValueType     numberOfBlocks = (numberOfPoints + blockSize - 1) / blockSize;
   MultiThreaderBase *     threader = this->GetMultiThreader();
   threader->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
