@@ -610,12 +610,9 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   std::vector<double> & coordinates = this->GetCoordinates();
   const SizeValueType   numberOfPoints = this->GetNumberOfCachedPoints();
 
-  // Stability of the explicit internal update requires a + 2b <= 1.
-  const double internalSum = m_Elasticity + 2.0 * m_Rigidity;
-  const double internalScale = internalSum > 1.0 ? 1.0 / internalSum : 1.0;
-  const bool   useElasticity = m_Elasticity * internalScale > 0.0;
-  const bool   useRigidity = m_Rigidity * internalScale > 0.0;
-  const bool   useNormal = m_Balloon != 0.0 || (useElasticity && m_TangentialElasticity);
+  const bool useElasticity = m_Elasticity > 0.0;
+  const bool useRigidity = m_Rigidity > 0.0;
+  const bool useNormal = m_Balloon != 0.0 || (useElasticity && m_TangentialElasticity);
 
   if (m_DisplacementMagnitudes.size() != numberOfPoints)
   {
@@ -736,7 +733,8 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
 {
   using namespace DeformableMeshFilterDetail;
   // Everything the loop reads, in locals: the compiler cannot keep members in
-  // registers across the stores to the output arrays.
+  // registers across the stores to the output arrays. Stability of the
+  // explicit internal update requires a + 2b <= 1: larger sums are scaled.
   const double        internalSum = m_Elasticity + 2.0 * m_Rigidity;
   const double        internalScale = internalSum > 1.0 ? 1.0 / internalSum : 1.0;
   const double        elasticity = m_Elasticity * internalScale;
