@@ -39,8 +39,10 @@
 #include "vtkWindowToImageFilter.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <thread>
 
 #ifdef EDM_HAVE_XLIB
 // Last: Xlib defines macros (None, Status, Bool) that VTK headers also use.
@@ -78,8 +80,15 @@ WhyNoOffscreenRendering()
            "xvfb-run -a";
   }
 #ifdef EDM_HAVE_XLIB
-  // VTK aborts the program when it cannot open the display: try first.
+  // VTK aborts the program when it cannot open the display: try first. A
+  // display that xvfb-run has just started may refuse connections for a
+  // moment on a loaded machine (seen in CI): retry for up to 10 s.
   Display * display = XOpenDisplay(nullptr);
+  for (int attempt = 0; display == nullptr && attempt < 50; ++attempt)
+  {
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    display = XOpenDisplay(nullptr);
+  }
   if (display == nullptr)
   {
     return "cannot open the X display '" + std::string(std::getenv("DISPLAY")) +
