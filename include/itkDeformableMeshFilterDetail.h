@@ -289,19 +289,6 @@ StoreFloat4(float * p, const Vec4 & v)
 #endif
 }
 
-/** Square root of each lane. */
-EDM_ALWAYS_INLINE Vec4
-Sqrt(const Vec4 & v)
-{
-#if EDM_VECTOR_EXTENSIONS
-  return _mm256_sqrt_pd(v);
-#elif EDM_VEC4_SSE2
-  return Vec4(_mm_sqrt_pd(v.lo), _mm_sqrt_pd(v.hi));
-#else
-  return Vec4{ std::sqrt(v[0]), std::sqrt(v[1]), std::sqrt(v[2]), std::sqrt(v[3]) };
-#endif
-}
-
 /** 1 / n, from a table for the usual vertex valences. */
 EDM_ALWAYS_INLINE double
 InverseCount(uint32_t n)
