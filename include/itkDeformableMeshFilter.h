@@ -290,6 +290,16 @@ private:
   static EDM_ALWAYS_INLINE Vec4
   SampleForce(const ForceSampler & sampler, const Vec4 & xi);
 
+  /** SampleForce() times \a scale at vertices [begin, end) (coordinates \a x,
+   * 3 per vertex), into forces[0, end - begin). */
+  static EDM_ALWAYS_INLINE void
+  SampleForces(const ForceSampler & sampler,
+               const double *       x,
+               SizeValueType        begin,
+               SizeValueType        end,
+               double               scale,
+               Vec4 *               forces);
+
   /** Umbrella vector u (centroid of the neighbours minus the vertex) and,
    * when NeedNormal, the outward unit normal n (area-weighted; 0 when
    * undefined) of vertex i. Lane 3 of both is 0. */

@@ -164,90 +164,143 @@ DeformableMeshFilter<TMesh, TForceImage>::SampleForce(const ForceSampler & sampl
   {
     return Vec4{};
   }
-#if EDM_VECTOR_EXTENSIONS
-  if (sampler.smallBuffer)
-  {
-    // The eight byte offsets, two vectors of four, from the clamped corners.
-    const __m256d f = _mm256_floor_pd(c);
-    const Vec4    w = c - f;
-    const Vec4    low = _mm256_max_pd(f, _mm256_setzero_pd()) * sampler.byteStrides;        // (x0, y0, z0, 0)
-    const Vec4    high = _mm256_min_pd(f + Splat(1.0), sampler.last) * sampler.byteStrides; // (x1, y1, z1, 0)
-    const __m256d xz = _mm256_unpacklo_pd(low, high);                                       // (x0, x1, z0, z1)
-    const __m256d yy = _mm256_unpackhi_pd(low, high);                                       // (y0, y1, 0, 0)
-    const __m256d yz = _mm256_add_pd(_mm256_permute4x64_pd(yy, 0x44), _mm256_permute4x64_pd(xz, 0xfa));
-    const __m128i atX0 = _mm256_cvttpd_epi32(_mm256_add_pd(yz, _mm256_permute4x64_pd(xz, 0x00)));
-    const __m128i atX1 = _mm256_cvttpd_epi32(_mm256_add_pd(yz, _mm256_permute4x64_pd(xz, 0x55)));
-    const char *  bytes = reinterpret_cast<const char *>(sampler.buffer);
-    auto          blend = [&](auto load) {
-      auto at = [bytes](int offset) -> const ForcePixelType & {
-        return *reinterpret_cast<const ForcePixelType *>(bytes + offset);
-      };
-      const Vec4 p000 = load(at(_mm_cvtsi128_si32(atX0)));
-      const Vec4 p100 = load(at(_mm_cvtsi128_si32(atX1)));
-      const Vec4 p010 = load(at(_mm_extract_epi32(atX0, 1)));
-      const Vec4 p110 = load(at(_mm_extract_epi32(atX1, 1)));
-      const Vec4 p001 = load(at(_mm_extract_epi32(atX0, 2)));
-      const Vec4 p101 = load(at(_mm_extract_epi32(atX1, 2)));
-      const Vec4 p011 = load(at(_mm_extract_epi32(atX0, 3)));
-      const Vec4 p111 = load(at(_mm_extract_epi32(atX1, 3)));
-      const Vec4 vx = Splat(w[0]);
-      const Vec4 a00 = p000 + vx * (p100 - p000);
-      const Vec4 a10 = p010 + vx * (p110 - p010);
-      const Vec4 a01 = p001 + vx * (p101 - p001);
-      const Vec4 a11 = p011 + vx * (p111 - p011);
-      const Vec4 vy = Splat(w[1]);
-      const Vec4 near = a00 + vy * (a10 - a00);
-      const Vec4 far = a01 + vy * (a11 - a01);
-      return ClearLane3(near + Splat(w[2]) * (far - near));
-    };
-    // A padded load reads past the pixel: not at the last pixel of the buffer.
-    if (_mm_extract_epi32(atX1, 3) < sampler.lastPixel * static_cast<int64_t>(sizeof(ForcePixelType)))
-    {
-      return blend([](const ForcePixelType & v) { return PixelLoader<ForcePixelType, true>::Load(v); });
-    }
-    return blend([](const ForcePixelType & v) { return PixelLoader<ForcePixelType, false>::Load(v); });
-  }
-#endif
   // c >= -0.5, so truncating c + 1 gives floor(c) + 1.
   const auto    fx = static_cast<int64_t>(c[0] + 1.0) - 1;
   const auto    fy = static_cast<int64_t>(c[1] + 1.0) - 1;
   const auto    fz = static_cast<int64_t>(c[2] + 1.0) - 1;
-  const double  wx = c[0] - static_cast<double>(fx);
-  const double  wy = c[1] - static_cast<double>(fy);
-  const double  wz = c[2] - static_cast<double>(fz);
   const int64_t x0 = std::max<int64_t>(fx, 0);
   const int64_t x1 = std::min<int64_t>(fx + 1, sampler.lastX);
   const int64_t y0 = std::max<int64_t>(fy, 0) * sampler.strideY;
   const int64_t y1 = std::min<int64_t>(fy + 1, sampler.lastY) * sampler.strideY;
   const int64_t z0 = std::max<int64_t>(fz, 0) * sampler.strideZ;
   const int64_t z1 = std::min<int64_t>(fz + 1, sampler.lastZ) * sampler.strideZ;
-
-  const ForcePixelType * p = sampler.buffer;
-  auto                   blend = [=](auto load) {
-    const Vec4 p000 = load(p[z0 + y0 + x0]);
-    const Vec4 p100 = load(p[z0 + y0 + x1]);
-    const Vec4 p010 = load(p[z0 + y1 + x0]);
-    const Vec4 p110 = load(p[z0 + y1 + x1]);
-    const Vec4 p001 = load(p[z1 + y0 + x0]);
-    const Vec4 p101 = load(p[z1 + y0 + x1]);
-    const Vec4 p011 = load(p[z1 + y1 + x0]);
-    const Vec4 p111 = load(p[z1 + y1 + x1]);
-    const Vec4 vx = Splat(wx);
-    const Vec4 a00 = p000 + vx * (p100 - p000);
-    const Vec4 a10 = p010 + vx * (p110 - p010);
-    const Vec4 a01 = p001 + vx * (p101 - p001);
-    const Vec4 a11 = p011 + vx * (p111 - p011);
-    const Vec4 vy = Splat(wy);
-    const Vec4 near = a00 + vy * (a10 - a00);
-    const Vec4 far = a01 + vy * (a11 - a01);
-    return ClearLane3(near + Splat(wz) * (far - near));
-  };
+  const int64_t corners[8] = { z0 + y0 + x0, z0 + y0 + x1, z0 + y1 + x0, z0 + y1 + x1,
+                               z1 + y0 + x0, z1 + y0 + x1, z1 + y1 + x0, z1 + y1 + x1 };
+  Vec4          p[8];
   // A padded load reads past the pixel: not at the last pixel of the buffer.
-  if (z1 + y1 + x1 < sampler.lastPixel)
+  if (corners[7] < sampler.lastPixel)
   {
-    return blend([](const ForcePixelType & v) { return PixelLoader<ForcePixelType, true>::Load(v); });
+    for (unsigned int k = 0; k < 8; ++k)
+    {
+      p[k] = PixelLoader<ForcePixelType, true>::Load(sampler.buffer[corners[k]]);
+    }
   }
-  return blend([](const ForcePixelType & v) { return PixelLoader<ForcePixelType, false>::Load(v); });
+  else
+  {
+    for (unsigned int k = 0; k < 8; ++k)
+    {
+      p[k] = PixelLoader<ForcePixelType, false>::Load(sampler.buffer[corners[k]]);
+    }
+  }
+  return Trilinear(p, c[0] - static_cast<double>(fx), c[1] - static_cast<double>(fy), c[2] - static_cast<double>(fz));
+}
+
+template <typename TMesh, typename TForceImage>
+EDM_ALWAYS_INLINE void
+DeformableMeshFilter<TMesh, TForceImage>::SampleForces(const ForceSampler & sampler,
+                                                       const double *       x,
+                                                       SizeValueType        begin,
+                                                       SizeValueType        end,
+                                                       double               scale,
+                                                       Vec4 *               forces)
+{
+  using namespace DeformableMeshFilterDetail;
+#if EDM_AVX2_SAMPLER
+  if (sampler.smallBuffer)
+  {
+    // Four vertices at a time: their coordinates as one register per axis,
+    // then continuous indices, inside test, weights and the byte offsets of
+    // the eight corners (clamped at the border) in the lanes of registers;
+    // the corners are then loaded and blended vertex by vertex.
+    const char *        bytes = reinterpret_cast<const char *>(sampler.buffer);
+    const __m128i       lastBytes = _mm_set1_epi32(static_cast<int32_t>(sampler.lastPixel * sizeof(ForcePixelType)));
+    alignas(32) int32_t corners[8][4];
+    alignas(32) double  weights[3][4];
+    double              tail[12];
+    for (SizeValueType j = begin; j < end; j += 4)
+    {
+      // The last group of a run may be short: its coordinates are copied,
+      // the missing vertices repeating the last one.
+      const SizeValueType count = std::min<SizeValueType>(4, end - j);
+      const double *      xj = x + 3 * j;
+      if (count < 4)
+      {
+        for (SizeValueType k = 0; k < 12; ++k)
+        {
+          tail[k] = xj[std::min(k, 3 * count - 3 + k % 3)];
+        }
+        xj = tail;
+      }
+      const __m256d a = _mm256_loadu_pd(xj);     // x0 y0 z0 x1
+      const __m256d b = _mm256_loadu_pd(xj + 4); // y1 z1 x2 y2
+      const __m256d c = _mm256_loadu_pd(xj + 8); // z2 x3 y3 z3
+      const __m256d axis[3] = { _mm256_permute4x64_pd(_mm256_blend_pd(_mm256_blend_pd(a, c, 0x2), b, 0x4), 0x6C),
+                                _mm256_permute4x64_pd(_mm256_blend_pd(_mm256_blend_pd(a, b, 0x9), c, 0x4), 0xB1),
+                                _mm256_permute4x64_pd(_mm256_blend_pd(_mm256_blend_pd(a, b, 0x2), c, 0x9), 0xC6) };
+      int           inside = 0xF;
+      __m128i       low[3];
+      __m128i       high[3];
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        // The products and sums in the order of SampleForce().
+        __m256d ck = _mm256_mul_pd(_mm256_set1_pd(sampler.columns[1][k]), axis[1]);
+        ck = _mm256_fmadd_pd(_mm256_set1_pd(sampler.columns[0][k]), axis[0], ck);
+        ck = _mm256_fmadd_pd(_mm256_set1_pd(sampler.columns[2][k]), axis[2], ck);
+        ck = _mm256_sub_pd(ck, _mm256_set1_pd(sampler.offset[k]));
+        inside &= _mm256_movemask_pd(_mm256_and_pd(_mm256_cmp_pd(ck, _mm256_set1_pd(sampler.lower[k]), _CMP_GE_OQ),
+                                                   _mm256_cmp_pd(ck, _mm256_set1_pd(sampler.upper[k]), _CMP_LT_OQ)));
+        const __m256d f = _mm256_floor_pd(ck);
+        const __m256d stride = _mm256_set1_pd(sampler.byteStrides[k]);
+        _mm256_store_pd(weights[k], _mm256_sub_pd(ck, f));
+        low[k] = _mm256_cvttpd_epi32(_mm256_mul_pd(_mm256_max_pd(f, _mm256_setzero_pd()), stride));
+        high[k] = _mm256_cvttpd_epi32(
+          _mm256_mul_pd(_mm256_min_pd(_mm256_add_pd(f, _mm256_set1_pd(1.0)), _mm256_set1_pd(sampler.last[k])), stride));
+      }
+      const __m128i yz[4] = { _mm_add_epi32(low[1], low[2]),
+                              _mm_add_epi32(high[1], low[2]),
+                              _mm_add_epi32(low[1], high[2]),
+                              _mm_add_epi32(high[1], high[2]) };
+      for (unsigned int k = 0; k < 4; ++k)
+      {
+        _mm_store_si128(reinterpret_cast<__m128i *>(corners[2 * k]), _mm_add_epi32(yz[k], low[0]));
+        _mm_store_si128(reinterpret_cast<__m128i *>(corners[2 * k + 1]), _mm_add_epi32(yz[k], high[0]));
+      }
+      // A padded load reads past the pixel: not at the last pixel of the buffer.
+      const int padded = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(lastBytes, _mm_add_epi32(yz[3], high[0]))));
+      for (SizeValueType l = 0; l < count; ++l)
+      {
+        Vec4 force{};
+        if (inside & (1 << l))
+        {
+          Vec4 p[8];
+          if (padded & (1 << l))
+          {
+            for (unsigned int k = 0; k < 8; ++k)
+            {
+              p[k] = PixelLoader<ForcePixelType, true>::Load(
+                *reinterpret_cast<const ForcePixelType *>(bytes + corners[k][l]));
+            }
+          }
+          else
+          {
+            for (unsigned int k = 0; k < 8; ++k)
+            {
+              p[k] = PixelLoader<ForcePixelType, false>::Load(
+                *reinterpret_cast<const ForcePixelType *>(bytes + corners[k][l]));
+            }
+          }
+          force = Splat(scale) * Trilinear(p, weights[0][l], weights[1][l], weights[2][l]);
+        }
+        forces[j - begin + l] = force;
+      }
+    }
+    return;
+  }
+#endif
+  for (SizeValueType j = begin; j < end; ++j)
+  {
+    forces[j - begin] = Splat(scale) * SampleForce(sampler, Load4(x + 3 * j));
+  }
 }
 
 template <typename TMesh, typename TForceImage>
@@ -766,11 +819,7 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
   {
     if ((i - begin) % run == 0)
     {
-      const SizeValueType runEnd = std::min(end, i + run);
-      for (SizeValueType j = i; j < runEnd; ++j)
-      {
-        externalForces[j - i] = Splat(scaleFactor) * SampleForce(sampler, Load4(x + 3 * j));
-      }
+      SampleForces(sampler, x, i, std::min(end, i + run), scaleFactor, externalForces);
     }
     const Vec4 xi = Load4(x + 3 * i);
     Vec4       u{};

@@ -59,6 +59,14 @@ namespace DeformableMeshFilterDetail
 #  define EDM_VEC4_SSE2 0
 #endif
 
+// The force sampler of DeformableMeshFilter computes the continuous indices,
+// weights and corner offsets of four vertices at a time in AVX2 registers.
+#if EDM_VECTOR_EXTENSIONS && defined(__AVX2__) && defined(__FMA__)
+#  define EDM_AVX2_SAMPLER 1
+#else
+#  define EDM_AVX2_SAMPLER 0
+#endif
+
 #if EDM_VECTOR_EXTENSIONS
 // Alignment 8: values are loaded from and stored to arrays of doubles at any
 // offset, and objects holding them need no over-aligned allocation.
@@ -395,6 +403,21 @@ struct PixelLoader<TPixel, true>
     return PixelLoader<TPixel, false>::Load(p);
   }
 };
+/** Trilinear interpolation of the corners p000, p100, p010, p110, p001, p101,
+ * p011, p111 (x fastest) with weights (wx, wy, wz) in [0, 1]. */
+EDM_ALWAYS_INLINE Vec4
+Trilinear(const Vec4 (&p)[8], double wx, double wy, double wz)
+{
+  const Vec4 vx = Splat(wx);
+  const Vec4 a00 = p[0] + vx * (p[1] - p[0]);
+  const Vec4 a10 = p[2] + vx * (p[3] - p[2]);
+  const Vec4 a01 = p[4] + vx * (p[5] - p[4]);
+  const Vec4 a11 = p[6] + vx * (p[7] - p[6]);
+  const Vec4 vy = Splat(wy);
+  const Vec4 near = a00 + vy * (a10 - a00);
+  const Vec4 far = a01 + vy * (a11 - a01);
+  return ClearLane3(near + Splat(wz) * (far - near));
+}
 } // namespace DeformableMeshFilterDetail
 } // namespace itk
 
