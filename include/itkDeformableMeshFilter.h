@@ -318,6 +318,16 @@ private:
   double
   StepBlock(SizeValueType begin, SizeValueType end, bool diagnose);
 
+  /** ComputeGeometry() for a ClosedRing vertex of K neighbours. */
+  template <unsigned int K, bool NeedNormal>
+  static EDM_ALWAYS_INLINE void
+  ClosedRingGeometry(const double *      x,
+                     const IndexType32 * ring,
+                     const Vec4 &        xi,
+                     double              orientationSign,
+                     Vec4 &              u,
+                     Vec4 &              n);
+
   /** ComputeGeometry() for a GeneralVertex. */
   void
   ComputeGeneralGeometry(const double * coordinates, SizeValueType i, Vec4 & u, Vec4 & n) const;

@@ -580,6 +580,30 @@ DeformableMeshFilter<TMesh, TForceImage>::ComputeGeometry(const double * x, Size
   // distance from the origin. Lane 3 carries junk (the next coordinate in
   // memory) until cleared.
   const Vec4 xi = Load4(x + 3 * i);
+  if (kind == ClosedRing)
+  {
+    // Straight-line code for the usual valences.
+    switch (end - begin)
+    {
+      case 4:
+        ClosedRingGeometry<4, NeedNormal>(x, ring + begin, xi, m_OrientationSign, u, n);
+        return;
+      case 5:
+        ClosedRingGeometry<5, NeedNormal>(x, ring + begin, xi, m_OrientationSign, u, n);
+        return;
+      case 6:
+        ClosedRingGeometry<6, NeedNormal>(x, ring + begin, xi, m_OrientationSign, u, n);
+        return;
+      case 7:
+        ClosedRingGeometry<7, NeedNormal>(x, ring + begin, xi, m_OrientationSign, u, n);
+        return;
+      case 8:
+        ClosedRingGeometry<8, NeedNormal>(x, ring + begin, xi, m_OrientationSign, u, n);
+        return;
+      default:
+        break;
+    }
+  }
   const Vec4 first = Load4(x + 3 * static_cast<SizeValueType>(ring[begin])) - xi;
   const Vec4 firstRotated = Rotate(first);
   Vec4       sum = first;
@@ -611,6 +635,54 @@ DeformableMeshFilter<TMesh, TForceImage>::ComputeGeometry(const double * x, Size
     const Vec4   normal = ClearLane3(Rotate(twisted));
     const double squaredLength = Dot3(normal, normal);
     n = squaredLength > 0.0 ? normal * Splat(m_OrientationSign / std::sqrt(squaredLength)) : Vec4{};
+  }
+}
+
+template <typename TMesh, typename TForceImage>
+template <unsigned int K, bool NeedNormal>
+EDM_ALWAYS_INLINE void
+DeformableMeshFilter<TMesh, TForceImage>::ClosedRingGeometry(const double *      x,
+                                                             const IndexType32 * ring,
+                                                             const Vec4 &        xi,
+                                                             double              orientationSign,
+                                                             Vec4 &              u,
+                                                             Vec4 &              n)
+{
+  using namespace DeformableMeshFilterDetail;
+  // As ComputeGeometry(), with the sums split in two (even and odd terms) to
+  // shorten their dependency chains.
+  Vec4 d[K];
+  Vec4 r[K];
+#if defined(__GNUC__) && !defined(__clang__)
+#  pragma GCC unroll 8
+#endif
+  for (unsigned int k = 0; k < K; ++k)
+  {
+    d[k] = Load4(x + 3 * static_cast<SizeValueType>(ring[k])) - xi;
+    r[k] = Rotate(d[k]);
+  }
+  Vec4 sum[2] = { d[0], d[1] };
+#if defined(__GNUC__) && !defined(__clang__)
+#  pragma GCC unroll 8
+#endif
+  for (unsigned int k = 2; k < K; ++k)
+  {
+    sum[k % 2] += d[k];
+  }
+  u = ClearLane3((sum[0] + sum[1]) * Splat(1.0 / static_cast<double>(K)));
+  if (NeedNormal)
+  {
+    Vec4 twisted[2] = { d[0] * r[1] - r[0] * d[1], d[1] * r[2] - r[1] * d[2] };
+#if defined(__GNUC__) && !defined(__clang__)
+#  pragma GCC unroll 8
+#endif
+    for (unsigned int k = 2; k < K; ++k)
+    {
+      twisted[k % 2] += d[k] * r[(k + 1) % K] - r[k] * d[(k + 1) % K];
+    }
+    const Vec4   normal = ClearLane3(Rotate(twisted[0] + twisted[1]));
+    const double squaredLength = Dot3(normal, normal);
+    n = squaredLength > 0.0 ? normal * Splat(orientationSign / std::sqrt(squaredLength)) : Vec4{};
   }
 }
 
@@ -836,12 +908,31 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
       const IndexType32 stop = offsets[i + 1];
       if (stop > first)
       {
-        Vec4 mean{};
-        for (IndexType32 k = first; k < stop; ++k)
+        Vec4 sum{};
+        switch (stop - first)
         {
-          mean += LoadFloat4(umbrellaField + 4 * static_cast<SizeValueType>(neighbours[k]));
+          case 4:
+            sum = GatherSum<4>(umbrellaField, neighbours + first);
+            break;
+          case 5:
+            sum = GatherSum<5>(umbrellaField, neighbours + first);
+            break;
+          case 6:
+            sum = GatherSum<6>(umbrellaField, neighbours + first);
+            break;
+          case 7:
+            sum = GatherSum<7>(umbrellaField, neighbours + first);
+            break;
+          case 8:
+            sum = GatherSum<8>(umbrellaField, neighbours + first);
+            break;
+          default:
+            for (IndexType32 k = first; k < stop; ++k)
+            {
+              sum += LoadFloat4(umbrellaField + 4 * static_cast<SizeValueType>(neighbours[k]));
+            }
         }
-        internal = Splat(rigidity) * (u - mean * Splat(InverseCount(stop - first)));
+        internal = Splat(rigidity) * (u - sum * Splat(InverseCount(stop - first)));
       }
     }
     else if (UseNormal)

@@ -403,6 +403,24 @@ struct PixelLoader<TPixel, true>
     return PixelLoader<TPixel, false>::Load(p);
   }
 };
+/** Sum of the 4-float vectors field[4 j] for the K indices j of \a indices,
+ * in two interleaved partial sums. K >= 2. */
+template <unsigned int K, typename TIndex>
+EDM_ALWAYS_INLINE Vec4
+GatherSum(const float * field, const TIndex * indices)
+{
+  Vec4 sum[2] = { LoadFloat4(field + 4 * static_cast<std::size_t>(indices[0])),
+                  LoadFloat4(field + 4 * static_cast<std::size_t>(indices[1])) };
+#if defined(__GNUC__) && !defined(__clang__)
+#  pragma GCC unroll 8
+#endif
+  for (unsigned int k = 2; k < K; ++k)
+  {
+    sum[k % 2] += LoadFloat4(field + 4 * static_cast<std::size_t>(indices[k]));
+  }
+  return sum[0] + sum[1];
+}
+
 /** Trilinear interpolation of the corners p000, p100, p010, p110, p001, p101,
  * p011, p111 (x fastest) with weights (wx, wy, wz) in [0, 1]. */
 EDM_ALWAYS_INLINE Vec4

@@ -763,6 +763,77 @@ TEST(InternalForces, OneStepMatchesTheDefinitionsOnClosedOpenAndIrregularVertice
   }
 }
 
+TEST(InternalForces, OneStepMatchesTheDefinitionsWhateverTheValence)
+{
+  // Irregular bipyramids: two apexes of valence K (a closed ring of K
+  // neighbours) around a ring of K vertices of valence 4. K from 3 to 12
+  // covers the valences with straight-line code and those without.
+  const auto field = ZeroForceField();
+  for (unsigned int K = 3; K <= 12; ++K)
+  {
+    auto      mesh = MeshType::New();
+    PointType p;
+    p[0] = 0.3;
+    p[1] = -0.2;
+    p[2] = 6.0;
+    mesh->SetPoint(0, p);
+    p[0] = -0.4;
+    p[1] = 0.1;
+    p[2] = -5.0;
+    mesh->SetPoint(1, p);
+    for (unsigned int k = 0; k < K; ++k)
+    {
+      const double angle = 2.0 * itk::Math::pi * (k + 0.2 * std::sin(5.0 * k)) / K;
+      const double radius = 5.0 + 0.7 * std::sin(3.0 * k);
+      p[0] = radius * std::cos(angle);
+      p[1] = radius * std::sin(angle);
+      p[2] = 0.5 * std::cos(2.0 * k);
+      mesh->SetPoint(2 + k, p);
+    }
+    itk::IdentifierType id = 0;
+    for (unsigned int k = 0; k < K; ++k)
+    {
+      const itk::IdentifierType a = 2 + k;
+      const itk::IdentifierType b = 2 + (k + 1) % K;
+      for (const std::array<itk::IdentifierType, 3> & t :
+           { std::array<itk::IdentifierType, 3>{ 0, a, b }, std::array<itk::IdentifierType, 3>{ 1, b, a } })
+      {
+        MeshType::CellAutoPointer cell;
+        cell.TakeOwnership(new itk::TriangleCell<MeshType::CellType>);
+        for (unsigned int m = 0; m < 3; ++m)
+        {
+          cell->SetPointId(m, t[m]);
+        }
+        mesh->SetCell(id++, cell);
+      }
+    }
+    for (const double rigidity : { 0.0, 0.2 })
+    {
+      auto filter = FilterType::New();
+      filter->SetInput(mesh);
+      filter->SetForceImage(field);
+      filter->SetElasticity(0.5);
+      filter->TangentialElasticityOff();
+      filter->SetRigidity(rigidity);
+      filter->SetBalloon(0.3);
+      filter->SetNumberOfIterations(1);
+      filter->Update();
+      ASSERT_EQ(filter->GetOrientationSign(), 1.0) << "K " << K;
+      EXPECT_EQ(GeneralVertexCount(filter), 0u) << "K " << K;
+      const auto expected = ExpectedStep(mesh, 0.5, rigidity, 0.3);
+      double     largestError = 0.0;
+      for (size_t i = 0; i < mesh->GetNumberOfPoints(); ++i)
+      {
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          largestError = std::max(largestError, std::abs(filter->GetOutput()->GetPoint(i)[d] - expected[3 * i + d]));
+        }
+      }
+      EXPECT_LT(largestError, rigidity > 0.0 ? 1e-6 : 1e-12) << "K " << K << ", rigidity " << rigidity;
+    }
+  }
+}
+
 TEST(InternalForces, DiagnosticsAreTheSameWhateverObservesTheFilter)
 {
   PointType center;
