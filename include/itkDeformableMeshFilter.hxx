@@ -212,11 +212,15 @@ DeformableMeshFilter<TMesh, TForceImage>::SampleForces(const ForceSampler & samp
     // then continuous indices, inside test, weights and the byte offsets of
     // the eight corners (clamped at the border) in the lanes of registers;
     // the corners are then loaded and blended vertex by vertex.
-    const char *        bytes = reinterpret_cast<const char *>(sampler.buffer);
-    const __m128i       lastBytes = _mm_set1_epi32(static_cast<int32_t>(sampler.lastPixel * sizeof(ForcePixelType)));
-    alignas(32) int32_t corners[8][4];
-    alignas(32) double  weights[3][4];
-    double              tail[12];
+    const char *  bytes = reinterpret_cast<const char *>(sampler.buffer);
+    const __m128i lastBytes = _mm_set1_epi32(static_cast<int32_t>(sampler.lastPixel * sizeof(ForcePixelType)));
+    constexpr SizeValueType maximumCount = 32; // the runs of StepBlock()
+    alignas(32) int32_t     corners[8][maximumCount];
+    alignas(32) double      weights[3][maximumCount];
+    uint32_t                insideBits = 0;
+    uint32_t                paddedBits = 0;
+    itkAssertInDebugAndIgnoreInReleaseMacro(end - begin <= maximumCount);
+    double tail[12];
     for (SizeValueType j = begin; j < end; j += 4)
     {
       // The last group of a run may be short: its coordinates are copied,
@@ -251,7 +255,7 @@ DeformableMeshFilter<TMesh, TForceImage>::SampleForces(const ForceSampler & samp
                                                    _mm256_cmp_pd(ck, _mm256_set1_pd(sampler.upper[k]), _CMP_LT_OQ)));
         const __m256d f = _mm256_floor_pd(ck);
         const __m256d stride = _mm256_set1_pd(sampler.byteStrides[k]);
-        _mm256_store_pd(weights[k], _mm256_sub_pd(ck, f));
+        _mm256_store_pd(weights[k] + (j - begin), _mm256_sub_pd(ck, f));
         low[k] = _mm256_cvttpd_epi32(_mm256_mul_pd(_mm256_max_pd(f, _mm256_setzero_pd()), stride));
         high[k] = _mm256_cvttpd_epi32(
           _mm256_mul_pd(_mm256_min_pd(_mm256_add_pd(f, _mm256_set1_pd(1.0)), _mm256_set1_pd(sampler.last[k])), stride));
@@ -262,37 +266,41 @@ DeformableMeshFilter<TMesh, TForceImage>::SampleForces(const ForceSampler & samp
                               _mm_add_epi32(high[1], high[2]) };
       for (unsigned int k = 0; k < 4; ++k)
       {
-        _mm_store_si128(reinterpret_cast<__m128i *>(corners[2 * k]), _mm_add_epi32(yz[k], low[0]));
-        _mm_store_si128(reinterpret_cast<__m128i *>(corners[2 * k + 1]), _mm_add_epi32(yz[k], high[0]));
+        _mm_store_si128(reinterpret_cast<__m128i *>(corners[2 * k] + (j - begin)), _mm_add_epi32(yz[k], low[0]));
+        _mm_store_si128(reinterpret_cast<__m128i *>(corners[2 * k + 1] + (j - begin)), _mm_add_epi32(yz[k], high[0]));
       }
       // A padded load reads past the pixel: not at the last pixel of the buffer.
       const int padded = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(lastBytes, _mm_add_epi32(yz[3], high[0]))));
-      for (SizeValueType l = 0; l < count; ++l)
+      insideBits |= static_cast<uint32_t>(inside) << (j - begin);
+      paddedBits |= static_cast<uint32_t>(padded) << (j - begin);
+    }
+    // Then the loads and blends, which depend on nothing but the offsets
+    // above: the loads of several vertices are in flight at once.
+    for (SizeValueType l = 0; l < end - begin; ++l)
+    {
+      Vec4 force{};
+      if (insideBits & (uint32_t{ 1 } << l))
       {
-        Vec4 force{};
-        if (inside & (1 << l))
+        Vec4 p[8];
+        if (paddedBits & (uint32_t{ 1 } << l))
         {
-          Vec4 p[8];
-          if (padded & (1 << l))
+          for (unsigned int k = 0; k < 8; ++k)
           {
-            for (unsigned int k = 0; k < 8; ++k)
-            {
-              p[k] = PixelLoader<ForcePixelType, true>::Load(
-                *reinterpret_cast<const ForcePixelType *>(bytes + corners[k][l]));
-            }
+            p[k] =
+              PixelLoader<ForcePixelType, true>::Load(*reinterpret_cast<const ForcePixelType *>(bytes + corners[k][l]));
           }
-          else
-          {
-            for (unsigned int k = 0; k < 8; ++k)
-            {
-              p[k] = PixelLoader<ForcePixelType, false>::Load(
-                *reinterpret_cast<const ForcePixelType *>(bytes + corners[k][l]));
-            }
-          }
-          force = Splat(scale) * Trilinear(p, weights[0][l], weights[1][l], weights[2][l]);
         }
-        forces[j - begin + l] = force;
+        else
+        {
+          for (unsigned int k = 0; k < 8; ++k)
+          {
+            p[k] = PixelLoader<ForcePixelType, false>::Load(
+              *reinterpret_cast<const ForcePixelType *>(bytes + corners[k][l]));
+          }
+        }
+        force = Splat(scale) * Trilinear(p, weights[0][l], weights[1][l], weights[2][l]);
       }
+      forces[l] = force;
     }
     return;
   }
@@ -564,7 +572,12 @@ DeformableMeshFilter<TMesh, TForceImage>::ComputeGeometry(const double * x, Size
   const uint8_t kind = m_RingKinds[i];
   if (kind == GeneralVertex)
   {
-    this->ComputeGeneralGeometry(x, i, u, n);
+    // Through temporaries: u and n stay in registers on the other paths.
+    Vec4 generalU;
+    Vec4 generalN;
+    this->ComputeGeneralGeometry(x, i, generalU, generalN);
+    u = generalU;
+    n = generalN;
     return;
   }
   const IndexType32   begin = m_NeighbourOffsets[i];
@@ -886,121 +899,129 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
   // interpolation; neighbour loads, normal) overlap across vertices.
   constexpr SizeValueType run = 32;
   Vec4                    externalForces[run];
+  double                  squaredSteps[run];
   double                  largest = 0.0; // squared
-  for (SizeValueType i = begin; i < end; ++i)
+  for (SizeValueType runBegin = begin; runBegin < end; runBegin += run)
   {
-    if ((i - begin) % run == 0)
+    const SizeValueType runEnd = std::min(end, runBegin + run);
+    SampleForces(sampler, x, runBegin, runEnd, scaleFactor, externalForces);
+    for (SizeValueType i = runBegin; i < runEnd; ++i)
     {
-      SampleForces(sampler, x, i, std::min(end, i + run), scaleFactor, externalForces);
-    }
-    const Vec4 xi = Load4(x + 3 * i);
-    Vec4       u{};
-    Vec4       n{};
-    Vec4       internal{};
-    if (UseRigidity)
-    {
-      u = LoadFloat4(umbrellaField + 4 * i);
+      const Vec4 xi = Load4(x + 3 * i);
+      Vec4       u{};
+      Vec4       n{};
+      Vec4       internal{};
+      if (UseRigidity)
+      {
+        u = LoadFloat4(umbrellaField + 4 * i);
+        if (UseNormal)
+        {
+          n = LoadFloat4(normalField + 4 * i);
+        }
+        const IndexType32 first = offsets[i];
+        const IndexType32 stop = offsets[i + 1];
+        if (stop > first)
+        {
+          Vec4 sum{};
+          switch (stop - first)
+          {
+            case 4:
+              sum = GatherSum<4>(umbrellaField, neighbours + first);
+              break;
+            case 5:
+              sum = GatherSum<5>(umbrellaField, neighbours + first);
+              break;
+            case 6:
+              sum = GatherSum<6>(umbrellaField, neighbours + first);
+              break;
+            case 7:
+              sum = GatherSum<7>(umbrellaField, neighbours + first);
+              break;
+            case 8:
+              sum = GatherSum<8>(umbrellaField, neighbours + first);
+              break;
+            default:
+              for (IndexType32 k = first; k < stop; ++k)
+              {
+                sum += LoadFloat4(umbrellaField + 4 * static_cast<SizeValueType>(neighbours[k]));
+              }
+          }
+          internal = Splat(rigidity) * (u - sum * Splat(InverseCount(stop - first)));
+        }
+      }
+      else if (UseNormal)
+      {
+        this->template ComputeGeometry<true>(x, i, u, n);
+      }
+      else if (useElasticity)
+      {
+        this->template ComputeGeometry<false>(x, i, u, n);
+      }
+      if (useElasticity)
+      {
+        const Vec4 e = tangential ? u - Dot4Splat(u, n) * n : u;
+        internal += Splat(elasticity) * e;
+      }
+
+      const Vec4 external = externalForces[i - runBegin];
+      // The balloon carries a vertex to an edge, not past it: once the external
+      // force opposes it with half its strength, the vertex is in the edge's
+      // capture range and the balloon is released for it, so that it settles on
+      // the edge itself instead of where the forces balance.
+      double inflation = 0.0;
+      if (UseNormal && balloon != 0.0 && !balloonReleased[i])
+      {
+        if (balloon * Dot3(external, n) <= -0.5 * balloon * balloon)
+        {
+          balloonReleased[i] = 1;
+        }
+        else
+        {
+          inflation = balloon;
+        }
+      }
+      Vec4 delta = external + internal;
       if (UseNormal)
       {
-        n = LoadFloat4(normalField + 4 * i);
+        delta += Splat(inflation) * n;
       }
-      const IndexType32 first = offsets[i];
-      const IndexType32 stop = offsets[i + 1];
-      if (stop > first)
+      if (maximumStep > 0.0)
       {
-        Vec4 sum{};
-        switch (stop - first)
+        const double length = std::sqrt(Dot3(delta, delta));
+        if (length > maximumStep)
         {
-          case 4:
-            sum = GatherSum<4>(umbrellaField, neighbours + first);
-            break;
-          case 5:
-            sum = GatherSum<5>(umbrellaField, neighbours + first);
-            break;
-          case 6:
-            sum = GatherSum<6>(umbrellaField, neighbours + first);
-            break;
-          case 7:
-            sum = GatherSum<7>(umbrellaField, neighbours + first);
-            break;
-          case 8:
-            sum = GatherSum<8>(umbrellaField, neighbours + first);
-            break;
-          default:
-            for (IndexType32 k = first; k < stop; ++k)
-            {
-              sum += LoadFloat4(umbrellaField + 4 * static_cast<SizeValueType>(neighbours[k]));
-            }
+          delta *= Splat(maximumStep / length);
         }
-        internal = Splat(rigidity) * (u - sum * Splat(InverseCount(stop - first)));
       }
-    }
-    else if (UseNormal)
-    {
-      this->template ComputeGeometry<true>(x, i, u, n);
-    }
-    else if (useElasticity)
-    {
-      this->template ComputeGeometry<false>(x, i, u, n);
-    }
-    if (useElasticity)
-    {
-      const Vec4 e = tangential ? u - Dot4Splat(u, n) * n : u;
-      internal += Splat(elasticity) * e;
-    }
-
-    const Vec4 external = externalForces[(i - begin) % run];
-    // The balloon carries a vertex to an edge, not past it: once the external
-    // force opposes it with half its strength, the vertex is in the edge's
-    // capture range and the balloon is released for it, so that it settles on
-    // the edge itself instead of where the forces balance.
-    double inflation = 0.0;
-    if (UseNormal && balloon != 0.0 && !balloonReleased[i])
-    {
-      if (balloon * Dot3(external, n) <= -0.5 * balloon * balloon)
+      // A 4-wide store spills into the next point's first coordinate, which the
+      // next iteration of this loop overwrites; not at the block's end.
+      if (i + 1 < end)
       {
-        balloonReleased[i] = 1;
+        Store4(next + 3 * i, xi + delta);
       }
       else
       {
-        inflation = balloon;
+        Store3(next + 3 * i, xi + delta);
       }
-    }
-    Vec4 delta = external + internal;
-    if (UseNormal)
-    {
-      delta += Splat(inflation) * n;
-    }
-    if (maximumStep > 0.0)
-    {
-      const double length = std::sqrt(Dot3(delta, delta));
-      if (length > maximumStep)
-      {
-        delta *= Splat(maximumStep / length);
-      }
-    }
-    // A 4-wide store spills into the next point's first coordinate, which the
-    // next iteration of this loop overwrites; not at the block's end.
-    if (i + 1 < end)
-    {
-      Store4(next + 3 * i, xi + delta);
-    }
-    else
-    {
-      Store3(next + 3 * i, xi + delta);
-    }
 
-    // Diagnostics, in single precision as they are stored: the three lengths
-    // with one square root. The largest displacement is kept squared.
-    if (diagnose)
-    {
-      const Vec4 squares = SquaredLengths(delta, external, internal);
-      SqrtStore3(squares, displacementMagnitudes + i, externalMagnitudes + i, internalMagnitudes + i);
-      largest = std::max(largest, squares[0]);
+      // Diagnostics, in single precision as they are stored: the three lengths
+      // with one square root. The largest displacement is kept squared.
+      if (diagnose)
+      {
+        const Vec4 squares = SquaredLengths(delta, external, internal);
+        SqrtStore3(squares, displacementMagnitudes + i, externalMagnitudes + i, internalMagnitudes + i);
+        squaredSteps[i - runBegin] = squares[0];
+      }
+      else
+      {
+        squaredSteps[i - runBegin] = Dot3(delta, delta);
+      }
     }
-    else
+    // Apart from the loop above: a running maximum there is a dependency
+    // chain through memory when the registers run short.
+    for (SizeValueType k = 0; k < runEnd - runBegin; ++k)
     {
-      largest = std::max(largest, Dot3(delta, delta));
+      largest = std::max(largest, squaredSteps[k]);
     }
   }
   return std::sqrt(largest);
