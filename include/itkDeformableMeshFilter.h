@@ -301,8 +301,10 @@ private:
                Vec4 *               forces);
 
   /** Umbrella vector u (centroid of the neighbours minus the vertex) and,
-   * when NeedNormal, the outward unit normal n (area-weighted; 0 when
-   * undefined) of vertex i. Lane 3 of both is 0. */
+   * when NeedNormal, the area-weighted normal n of vertex i: the sum of the
+   * cross products of its triangles' edges from the vertex, neither unit nor
+   * oriented (UnitVector() with m_OrientationSign makes it the outward unit
+   * normal). Lane 3 of both is 0. */
   template <bool NeedNormal>
   EDM_ALWAYS_INLINE void
   ComputeGeometry(const double * coordinates, SizeValueType i, Vec4 & u, Vec4 & n) const;
@@ -321,12 +323,7 @@ private:
   /** ComputeGeometry() for a ClosedRing vertex of K neighbours. */
   template <unsigned int K, bool NeedNormal>
   static EDM_ALWAYS_INLINE void
-  ClosedRingGeometry(const double *      x,
-                     const IndexType32 * ring,
-                     const Vec4 &        xi,
-                     double              orientationSign,
-                     Vec4 &              u,
-                     Vec4 &              n);
+  ClosedRingGeometry(const double * x, const IndexType32 * ring, const Vec4 & xi, Vec4 & u, Vec4 & n);
 
   /** ComputeGeometry() for a GeneralVertex. */
   void

@@ -599,19 +599,19 @@ DeformableMeshFilter<TMesh, TForceImage>::ComputeGeometry(const double * x, Size
     switch (end - begin)
     {
       case 4:
-        ClosedRingGeometry<4, NeedNormal>(x, ring + begin, xi, m_OrientationSign, u, n);
+        ClosedRingGeometry<4, NeedNormal>(x, ring + begin, xi, u, n);
         return;
       case 5:
-        ClosedRingGeometry<5, NeedNormal>(x, ring + begin, xi, m_OrientationSign, u, n);
+        ClosedRingGeometry<5, NeedNormal>(x, ring + begin, xi, u, n);
         return;
       case 6:
-        ClosedRingGeometry<6, NeedNormal>(x, ring + begin, xi, m_OrientationSign, u, n);
+        ClosedRingGeometry<6, NeedNormal>(x, ring + begin, xi, u, n);
         return;
       case 7:
-        ClosedRingGeometry<7, NeedNormal>(x, ring + begin, xi, m_OrientationSign, u, n);
+        ClosedRingGeometry<7, NeedNormal>(x, ring + begin, xi, u, n);
         return;
       case 8:
-        ClosedRingGeometry<8, NeedNormal>(x, ring + begin, xi, m_OrientationSign, u, n);
+        ClosedRingGeometry<8, NeedNormal>(x, ring + begin, xi, u, n);
         return;
       default:
         break;
@@ -645,9 +645,7 @@ DeformableMeshFilter<TMesh, TForceImage>::ComputeGeometry(const double * x, Size
     {
       twisted += previous * firstRotated - previousRotated * first;
     }
-    const Vec4   normal = ClearLane3(Rotate(twisted));
-    const double squaredLength = Dot3(normal, normal);
-    n = squaredLength > 0.0 ? normal * Splat(m_OrientationSign / std::sqrt(squaredLength)) : Vec4{};
+    n = ClearLane3(Rotate(twisted));
   }
 }
 
@@ -657,7 +655,6 @@ EDM_ALWAYS_INLINE void
 DeformableMeshFilter<TMesh, TForceImage>::ClosedRingGeometry(const double *      x,
                                                              const IndexType32 * ring,
                                                              const Vec4 &        xi,
-                                                             double              orientationSign,
                                                              Vec4 &              u,
                                                              Vec4 &              n)
 {
@@ -693,9 +690,7 @@ DeformableMeshFilter<TMesh, TForceImage>::ClosedRingGeometry(const double *     
     {
       twisted[k % 2] += d[k] * r[(k + 1) % K] - r[k] * d[(k + 1) % K];
     }
-    const Vec4   normal = ClearLane3(Rotate(twisted[0] + twisted[1]));
-    const double squaredLength = Dot3(normal, normal);
-    n = squaredLength > 0.0 ? normal * Splat(orientationSign / std::sqrt(squaredLength)) : Vec4{};
+    n = ClearLane3(Rotate(twisted[0] + twisted[1]));
   }
 }
 
@@ -735,9 +730,7 @@ DeformableMeshFilter<TMesh, TForceImage>::ComputeGeneralGeometry(const double * 
     normal[1] += e[2] * f[0] - e[0] * f[2];
     normal[2] += e[0] * f[1] - e[1] * f[0];
   }
-  const double length = std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
-  const double scale = length > 0.0 ? m_OrientationSign / length : 0.0;
-  n = Vec4{ normal[0] * scale, normal[1] * scale, normal[2] * scale, 0.0 };
+  n = Vec4{ normal[0], normal[1], normal[2], 0.0 };
 }
 
 template <typename TMesh, typename TForceImage>
@@ -851,15 +844,37 @@ DeformableMeshFilter<TMesh, TForceImage>::GeometryBlock(SizeValueType begin, Siz
   const double * x = this->GetCoordinates().data();
   float *        umbrellaField = m_Umbrella.data();
   float *        normalField = m_Normals.data();
-  Vec4           u;
-  Vec4           n;
-  for (SizeValueType i = begin; i < end; ++i)
+  const double   orientationSign = m_OrientationSign;
+  // The normals of a chunk of vertices are scaled to unit length after the
+  // chunk: the square roots and divisions then overlap across vertices
+  // instead of ending each vertex's chain of dependent operations.
+  constexpr SizeValueType chunk = 32;
+  Vec4                    normals[chunk];
+  double                  squaredLengths[chunk];
+  for (SizeValueType chunkBegin = begin; chunkBegin < end; chunkBegin += chunk)
   {
-    this->template ComputeGeometry<NeedNormal>(x, i, u, n);
-    StoreFloat4(umbrellaField + 4 * i, u);
+    const SizeValueType chunkEnd = std::min(end, chunkBegin + chunk);
+    for (SizeValueType i = chunkBegin; i < chunkEnd; ++i)
+    {
+      Vec4 u;
+      Vec4 n;
+      this->template ComputeGeometry<NeedNormal>(x, i, u, n);
+      StoreFloat4(umbrellaField + 4 * i, u);
+      if (NeedNormal)
+      {
+        normals[i - chunkBegin] = n;
+        squaredLengths[i - chunkBegin] = Dot3(n, n);
+      }
+    }
     if (NeedNormal)
     {
-      StoreFloat4(normalField + 4 * i, n);
+      for (SizeValueType i = chunkBegin; i < chunkEnd; ++i)
+      {
+        const double squaredLength = squaredLengths[i - chunkBegin];
+        StoreFloat4(normalField + 4 * i,
+                    squaredLength > 0.0 ? normals[i - chunkBegin] * Splat(orientationSign / std::sqrt(squaredLength))
+                                        : Vec4{});
+      }
     }
   }
 }
@@ -882,6 +897,7 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
   const double        scaleFactor = m_ScaleFactor;
   const double        balloon = m_Balloon;
   const double        maximumStep = m_MaximumStepLength;
+  const double        orientationSign = m_OrientationSign;
   const ForceSampler  sampler = m_Sampler;
   const double *      x = this->GetCoordinates().data();
   double *            next = m_NextCoordinates.data();
@@ -952,6 +968,7 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
       else if (UseNormal)
       {
         this->template ComputeGeometry<true>(x, i, u, n);
+        n = UnitVector(n, orientationSign);
       }
       else if (useElasticity)
       {

@@ -403,6 +403,14 @@ struct PixelLoader<TPixel, true>
     return PixelLoader<TPixel, false>::Load(p);
   }
 };
+/** n / |n| times sign (lane 3 of n must be 0); 0 when n is 0. */
+EDM_ALWAYS_INLINE Vec4
+UnitVector(const Vec4 & n, double sign)
+{
+  const double squaredLength = Dot3(n, n);
+  return squaredLength > 0.0 ? n * Splat(sign / std::sqrt(squaredLength)) : Vec4{};
+}
+
 /** Sum of the 4-float vectors field[4 j] for the K indices j of \a indices,
  * in two interleaved partial sums. K >= 2. */
 template <unsigned int K, typename TIndex>
