@@ -291,7 +291,7 @@ private:
   SampleForce(const ForceSampler & sampler, const Vec4 & xi);
 
   /** SampleForce() times \a scale at vertices [begin, end) (coordinates \a x,
-   * 3 per vertex), into forces[0, end - begin). */
+   * 3 per vertex), into forces[0, end - begin); at most 32 vertices. */
   static EDM_ALWAYS_INLINE void
   SampleForces(const ForceSampler & sampler,
                const double *       x,
