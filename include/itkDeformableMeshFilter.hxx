@@ -850,7 +850,6 @@ DeformableMeshFilter<TMesh, TForceImage>::GeometryBlock(SizeValueType begin, Siz
   // instead of ending each vertex's chain of dependent operations.
   constexpr SizeValueType chunk = 32;
   Vec4                    normals[chunk];
-  double                  squaredLengths[chunk];
   for (SizeValueType chunkBegin = begin; chunkBegin < end; chunkBegin += chunk)
   {
     const SizeValueType chunkEnd = std::min(end, chunkBegin + chunk);
@@ -863,14 +862,13 @@ DeformableMeshFilter<TMesh, TForceImage>::GeometryBlock(SizeValueType begin, Siz
       if (NeedNormal)
       {
         normals[i - chunkBegin] = n;
-        squaredLengths[i - chunkBegin] = Dot3(n, n);
       }
     }
     if (NeedNormal)
     {
       for (SizeValueType i = chunkBegin; i < chunkEnd; ++i)
       {
-        const double squaredLength = squaredLengths[i - chunkBegin];
+        const double squaredLength = Dot3(normals[i - chunkBegin], normals[i - chunkBegin]);
         StoreFloat4(normalField + 4 * i,
                     squaredLength > 0.0 ? normals[i - chunkBegin] * Splat(orientationSign / std::sqrt(squaredLength))
                                         : Vec4{});
