@@ -593,29 +593,12 @@ DeformableMeshFilter<TMesh, TForceImage>::ComputeGeometry(const double * x, Size
   // distance from the origin. Lane 3 carries junk (the next coordinate in
   // memory) until cleared.
   const Vec4 xi = Load4(x + 3 * i);
-  if (kind == ClosedRing)
+  // Straight-line code for the usual valences.
+  if (kind == ClosedRing && WithUsualValence(end - begin, [&](auto valence) {
+        ClosedRingGeometry<decltype(valence)::value, NeedNormal>(x, ring + begin, xi, u, n);
+      }))
   {
-    // Straight-line code for the usual valences.
-    switch (end - begin)
-    {
-      case 4:
-        ClosedRingGeometry<4, NeedNormal>(x, ring + begin, xi, u, n);
-        return;
-      case 5:
-        ClosedRingGeometry<5, NeedNormal>(x, ring + begin, xi, u, n);
-        return;
-      case 6:
-        ClosedRingGeometry<6, NeedNormal>(x, ring + begin, xi, u, n);
-        return;
-      case 7:
-        ClosedRingGeometry<7, NeedNormal>(x, ring + begin, xi, u, n);
-        return;
-      case 8:
-        ClosedRingGeometry<8, NeedNormal>(x, ring + begin, xi, u, n);
-        return;
-      default:
-        break;
-    }
+    return;
   }
   const Vec4 first = Load4(x + 3 * static_cast<SizeValueType>(ring[begin])) - xi;
   const Vec4 firstRotated = Rotate(first);
@@ -937,28 +920,14 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
         if (stop > first)
         {
           Vec4 sum{};
-          switch (stop - first)
+          if (!WithUsualValence(stop - first, [&](auto valence) {
+                sum = GatherSum<decltype(valence)::value>(umbrellaField, neighbours + first);
+              }))
           {
-            case 4:
-              sum = GatherSum<4>(umbrellaField, neighbours + first);
-              break;
-            case 5:
-              sum = GatherSum<5>(umbrellaField, neighbours + first);
-              break;
-            case 6:
-              sum = GatherSum<6>(umbrellaField, neighbours + first);
-              break;
-            case 7:
-              sum = GatherSum<7>(umbrellaField, neighbours + first);
-              break;
-            case 8:
-              sum = GatherSum<8>(umbrellaField, neighbours + first);
-              break;
-            default:
-              for (IndexType32 k = first; k < stop; ++k)
-              {
-                sum += LoadFloat4(umbrellaField + 4 * static_cast<SizeValueType>(neighbours[k]));
-              }
+            for (IndexType32 k = first; k < stop; ++k)
+            {
+              sum += LoadFloat4(umbrellaField + 4 * static_cast<SizeValueType>(neighbours[k]));
+            }
           }
           internal = Splat(rigidity) * (u - sum * Splat(InverseCount(stop - first)));
         }

@@ -411,6 +411,35 @@ UnitVector(const Vec4 & n, double sign)
   return squaredLength > 0.0 ? n * Splat(sign / std::sqrt(squaredLength)) : Vec4{};
 }
 
+/** For a count of 4 to 8 (the usual valences), calls
+ * f(std::integral_constant<unsigned int, count>()) and returns true; returns
+ * false for other counts. The step has straight-line code for these. */
+template <typename TFunction>
+EDM_ALWAYS_INLINE bool
+WithUsualValence(uint32_t count, TFunction && f)
+{
+  switch (count)
+  {
+    case 4:
+      f(std::integral_constant<unsigned int, 4>());
+      return true;
+    case 5:
+      f(std::integral_constant<unsigned int, 5>());
+      return true;
+    case 6:
+      f(std::integral_constant<unsigned int, 6>());
+      return true;
+    case 7:
+      f(std::integral_constant<unsigned int, 7>());
+      return true;
+    case 8:
+      f(std::integral_constant<unsigned int, 8>());
+      return true;
+    default:
+      return false;
+  }
+}
+
 /** Sum of the 4-float vectors field[4 j] for the K indices j of \a indices,
  * in two interleaved partial sums. K >= 2. */
 template <unsigned int K, typename TIndex>

@@ -674,6 +674,36 @@ MakeMesh(const MeshType * points, const std::vector<std::vector<itk::IdentifierT
   return mesh;
 }
 
+namespace
+{
+/** One step of the filter on \a mesh (Elasticity 0.5, not tangential,
+ * \a rigidity, Balloon 0.3); \a largestError: the largest coordinate
+ * difference from ExpectedStep(). */
+FilterType::Pointer
+OneStep(const MeshType * mesh, const ForceImageType * field, double rigidity, double & largestError)
+{
+  auto filter = FilterType::New();
+  filter->SetInput(mesh);
+  filter->SetForceImage(field);
+  filter->SetElasticity(0.5);
+  filter->TangentialElasticityOff();
+  filter->SetRigidity(rigidity);
+  filter->SetBalloon(0.3);
+  filter->SetNumberOfIterations(1);
+  filter->Update();
+  const auto expected = ExpectedStep(mesh, 0.5, rigidity, 0.3);
+  largestError = 0.0;
+  for (size_t i = 0; i < mesh->GetNumberOfPoints(); ++i)
+  {
+    for (unsigned int d = 0; d < 3; ++d)
+    {
+      largestError = std::max(largestError, std::abs(filter->GetOutput()->GetPoint(i)[d] - expected[3 * i + d]));
+    }
+  }
+  return filter;
+}
+} // namespace
+
 TEST(InternalForces, OneStepMatchesTheDefinitionsOnClosedOpenAndIrregularVertices)
 {
   PointType center;
@@ -735,25 +765,9 @@ TEST(InternalForces, OneStepMatchesTheDefinitionsOnClosedOpenAndIrregularVertice
     const auto   mesh = MakeMesh(sphere, cells);
     for (const double rigidity : { 0.0, 0.2 })
     {
-      auto filter = FilterType::New();
-      filter->SetInput(mesh);
-      filter->SetForceImage(field);
-      filter->SetElasticity(0.5);
-      filter->TangentialElasticityOff();
-      filter->SetRigidity(rigidity);
-      filter->SetBalloon(0.3);
-      filter->SetNumberOfIterations(1);
-      filter->Update();
-      ASSERT_EQ(filter->GetOrientationSign(), 1.0);
-      const auto expected = ExpectedStep(mesh, 0.5, rigidity, 0.3);
       double     largestError = 0.0;
-      for (size_t i = 0; i < mesh->GetNumberOfPoints(); ++i)
-      {
-        for (unsigned int d = 0; d < 3; ++d)
-        {
-          largestError = std::max(largestError, std::abs(filter->GetOutput()->GetPoint(i)[d] - expected[3 * i + d]));
-        }
-      }
+      const auto filter = OneStep(mesh, field, rigidity, largestError);
+      ASSERT_EQ(filter->GetOrientationSign(), 1.0);
       // With rigidity the umbrella vectors and normals pass through single
       // precision between the two passes of the step: 6e-8 of forces < 1.
       EXPECT_LT(largestError, rigidity > 0.0 ? 1e-7 : 1e-12) << cells.size() << " cells, rigidity " << rigidity;
@@ -809,26 +823,10 @@ TEST(InternalForces, OneStepMatchesTheDefinitionsWhateverTheValence)
     }
     for (const double rigidity : { 0.0, 0.2 })
     {
-      auto filter = FilterType::New();
-      filter->SetInput(mesh);
-      filter->SetForceImage(field);
-      filter->SetElasticity(0.5);
-      filter->TangentialElasticityOff();
-      filter->SetRigidity(rigidity);
-      filter->SetBalloon(0.3);
-      filter->SetNumberOfIterations(1);
-      filter->Update();
+      double     largestError = 0.0;
+      const auto filter = OneStep(mesh, field, rigidity, largestError);
       ASSERT_EQ(filter->GetOrientationSign(), 1.0) << "K " << K;
       EXPECT_EQ(GeneralVertexCount(filter), 0u) << "K " << K;
-      const auto expected = ExpectedStep(mesh, 0.5, rigidity, 0.3);
-      double     largestError = 0.0;
-      for (size_t i = 0; i < mesh->GetNumberOfPoints(); ++i)
-      {
-        for (unsigned int d = 0; d < 3; ++d)
-        {
-          largestError = std::max(largestError, std::abs(filter->GetOutput()->GetPoint(i)[d] - expected[3 * i + d]));
-        }
-      }
       EXPECT_LT(largestError, rigidity > 0.0 ? 1e-6 : 1e-12) << "K " << K << ", rigidity " << rigidity;
     }
   }
