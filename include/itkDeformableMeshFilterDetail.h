@@ -403,6 +403,7 @@ struct PixelLoader<TPixel, true>
     return PixelLoader<TPixel, false>::Load(p);
   }
 };
+
 /** n / |n| times sign (lane 3 of n must be 0); 0 when n is 0. */
 EDM_ALWAYS_INLINE Vec4
 UnitVector(const Vec4 & n, double sign)
