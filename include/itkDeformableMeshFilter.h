@@ -354,6 +354,9 @@ private:
   std::vector<IndexType32> m_GeneralPairOffsets;
   std::vector<IndexType32> m_GeneralPairs;
   SizeValueType            m_NumberOfTriangles{ 0 };
+  // Straight-line code for closed rings of 4 to 8 neighbours: when at least
+  // three quarters of the closed-ring vertices share one such valence.
+  bool m_StraightLineRings{ false };
 
   // Per-vertex state. Next coordinates: 3 per vertex and a guard value, as
   // the cached coordinates they are swapped with; umbrella vectors and

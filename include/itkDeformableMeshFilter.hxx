@@ -542,6 +542,22 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology()
   }
   m_OrientationSign = volume < 0.0 ? -1.0 : 1.0;
   m_NumberOfTriangles = numberOfTriangles;
+
+  // Straight-line code per valence pays when the valence rarely changes from
+  // one vertex to the next (regular and subdivided meshes); on meshes of mixed
+  // valences (marching cubes) the mispredicted jumps cost more than the loop.
+  SizeValueType ringCounts[9] = {};
+  SizeValueType closedRings = 0;
+  for (SizeValueType i = 0; i < numberOfPoints; ++i)
+  {
+    if (m_RingKinds[i] == ClosedRing)
+    {
+      ++closedRings;
+      ++ringCounts[std::min<IndexType32>(8, m_NeighbourOffsets[i + 1] - m_NeighbourOffsets[i])];
+    }
+  }
+  const SizeValueType mostCommon = *std::max_element(ringCounts + 4, ringCounts + 9);
+  m_StraightLineRings = closedRings > 0 && 4 * mostCommon >= 3 * closedRings;
 }
 
 template <typename TMesh, typename TForceImage>
@@ -594,7 +610,7 @@ DeformableMeshFilter<TMesh, TForceImage>::ComputeGeometry(const double * x, Size
   // memory) until cleared.
   const Vec4 xi = Load4(x + 3 * i);
   // Straight-line code for the usual valences.
-  if (kind == ClosedRing && WithUsualValence(end - begin, [&](auto valence) {
+  if (kind == ClosedRing && m_StraightLineRings && WithUsualValence(end - begin, [&](auto valence) {
         ClosedRingGeometry<decltype(valence)::value, NeedNormal>(x, ring + begin, xi, u, n);
       }))
   {
@@ -879,6 +895,7 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
   const double        balloon = m_Balloon;
   const double        maximumStep = m_MaximumStepLength;
   const double        orientationSign = m_OrientationSign;
+  const bool          straightLineRings = m_StraightLineRings;
   const ForceSampler  sampler = m_Sampler;
   const double *      x = this->GetCoordinates().data();
   double *            next = m_NextCoordinates.data();
@@ -920,7 +937,7 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
         if (stop > first)
         {
           Vec4 sum{};
-          if (!WithUsualValence(stop - first, [&](auto valence) {
+          if (!straightLineRings || !WithUsualValence(stop - first, [&](auto valence) {
                 sum = GatherSum<decltype(valence)::value>(umbrellaField, neighbours + first);
               }))
           {
@@ -1030,6 +1047,7 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "OrientationSign: " << m_OrientationSign << std::endl;
   os << indent << "Neighbours: " << m_Neighbours.size() << " entries, Triangles: " << m_NumberOfTriangles
      << ", vertices outside a single fan: " << m_GeneralVertices.size() << std::endl;
+  os << indent << "StraightLineRings: " << (m_StraightLineRings ? "On" : "Off") << std::endl;
   os << indent << "ForceBuffer: " << m_ForceBuffer << std::endl;
   os << indent << "PhysicalToIndex: [" << m_PhysicalToIndex[0][0] << ' ' << m_PhysicalToIndex[0][1] << ' '
      << m_PhysicalToIndex[0][2] << "; " << m_PhysicalToIndex[1][0] << ' ' << m_PhysicalToIndex[1][1] << ' '

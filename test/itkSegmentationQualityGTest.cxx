@@ -643,6 +643,16 @@ GeneralVertexCount(const FilterType * filter)
   const auto        where = text.find(key);
   return where == std::string::npos ? size_t(-1) : std::stoul(text.substr(where + key.size()));
 }
+
+/** Whether the filter uses its straight-line code for closed rings, read from
+ * its Print() output. */
+bool
+StraightLineRings(const FilterType * filter)
+{
+  std::ostringstream os;
+  filter->Print(os);
+  return os.str().find("StraightLineRings: On") != std::string::npos;
+}
 } // namespace
 
 /** A mesh of the given points and cells: 2 ids a line, 3 a triangle, 4 a
@@ -779,10 +789,33 @@ TEST(InternalForces, OneStepMatchesTheDefinitionsOnClosedOpenAndIrregularVertice
 
 TEST(InternalForces, OneStepMatchesTheDefinitionsWhateverTheValence)
 {
+  const auto field = ZeroForceField();
+  const auto check = [&field](const MeshType * mesh, const std::string & name, bool straightLine) {
+    for (const double rigidity : { 0.0, 0.2 })
+    {
+      double     largestError = 0.0;
+      const auto filter = OneStep(mesh, field, rigidity, largestError);
+      ASSERT_EQ(filter->GetOrientationSign(), 1.0) << name;
+      EXPECT_EQ(GeneralVertexCount(filter), 0u) << name;
+      EXPECT_EQ(StraightLineRings(filter), straightLine) << name;
+      EXPECT_LT(largestError, rigidity > 0.0 ? 1e-6 : 1e-12) << name << ", rigidity " << rigidity;
+    }
+  };
+  const auto addTriangle = [](MeshType * mesh, itk::IdentifierType id, const std::array<itk::IdentifierType, 3> & t) {
+    MeshType::CellAutoPointer cell;
+    cell.TakeOwnership(new itk::TriangleCell<MeshType::CellType>);
+    for (unsigned int m = 0; m < 3; ++m)
+    {
+      cell->SetPointId(m, t[m]);
+    }
+    mesh->SetCell(id, cell);
+  };
+
   // Irregular bipyramids: two apexes of valence K (a closed ring of K
   // neighbours) around a ring of K vertices of valence 4. K from 3 to 12
-  // covers the valences with straight-line code and those without.
-  const auto field = ZeroForceField();
+  // covers the valences with straight-line code and those without; the
+  // filter uses that code when three quarters of the vertices share a
+  // valence (here valence 4 from K = 6 on, and all of them for K = 4).
   for (unsigned int K = 3; K <= 12; ++K)
   {
     auto      mesh = MeshType::New();
@@ -804,32 +837,69 @@ TEST(InternalForces, OneStepMatchesTheDefinitionsWhateverTheValence)
       p[2] = 0.5 * std::cos(2.0 * k);
       mesh->SetPoint(2 + k, p);
     }
-    itk::IdentifierType id = 0;
     for (unsigned int k = 0; k < K; ++k)
     {
       const itk::IdentifierType a = 2 + k;
       const itk::IdentifierType b = 2 + (k + 1) % K;
-      for (const std::array<itk::IdentifierType, 3> & t :
-           { std::array<itk::IdentifierType, 3>{ 0, a, b }, std::array<itk::IdentifierType, 3>{ 1, b, a } })
+      addTriangle(mesh, 2 * k, { 0, a, b });
+      addTriangle(mesh, 2 * k + 1, { 1, b, a });
+    }
+    check(mesh, "bipyramid K " + std::to_string(K), K == 4 || K >= 6);
+  }
+
+  // An irregular icosahedron: every vertex of valence 5.
+  const double phi = (1.0 + std::sqrt(5.0)) / 2.0;
+  auto         icosahedron = MeshType::New();
+  for (unsigned int k = 0; k < 12; ++k)
+  {
+    // (0, +-1, +-phi) and its cyclic permutations.
+    const double a = (k & 1) ? -1.0 : 1.0;
+    const double b = (k & 2) ? -phi : phi;
+    const double v[3] = { 0.0, a, b };
+    PointType    p;
+    for (unsigned int d = 0; d < 3; ++d)
+    {
+      p[d] = 3.0 * v[(d + 3 - k / 4) % 3];
+    }
+    icosahedron->SetPoint(k, p);
+  }
+  // Faces: triples of vertices two apart (the edge length), oriented outward;
+  // the vertices are moved off the regular shape afterwards.
+  itk::IdentifierType faces = 0;
+  const auto          near = [&icosahedron](itk::IdentifierType i, itk::IdentifierType j) {
+    return icosahedron->GetPoint(i).EuclideanDistanceTo(icosahedron->GetPoint(j)) < 6.5;
+  };
+  for (itk::IdentifierType i = 0; i < 12; ++i)
+  {
+    for (itk::IdentifierType j = i + 1; j < 12; ++j)
+    {
+      for (itk::IdentifierType k = j + 1; k < 12; ++k)
       {
-        MeshType::CellAutoPointer cell;
-        cell.TakeOwnership(new itk::TriangleCell<MeshType::CellType>);
-        for (unsigned int m = 0; m < 3; ++m)
+        if (near(i, j) && near(j, k) && near(i, k))
         {
-          cell->SetPointId(m, t[m]);
+          const auto a = icosahedron->GetPoint(i);
+          const auto e = icosahedron->GetPoint(j) - a;
+          const auto f = icosahedron->GetPoint(k) - a;
+          const auto outward = itk::CrossProduct(e, f) * a.GetVectorFromOrigin() > 0.0;
+          addTriangle(icosahedron,
+                      faces++,
+                      outward ? std::array<itk::IdentifierType, 3>{ i, j, k }
+                              : std::array<itk::IdentifierType, 3>{ i, k, j });
         }
-        mesh->SetCell(id++, cell);
       }
     }
-    for (const double rigidity : { 0.0, 0.2 })
-    {
-      double     largestError = 0.0;
-      const auto filter = OneStep(mesh, field, rigidity, largestError);
-      ASSERT_EQ(filter->GetOrientationSign(), 1.0) << "K " << K;
-      EXPECT_EQ(GeneralVertexCount(filter), 0u) << "K " << K;
-      EXPECT_LT(largestError, rigidity > 0.0 ? 1e-6 : 1e-12) << "K " << K << ", rigidity " << rigidity;
-    }
   }
+  ASSERT_EQ(faces, 20u);
+  for (itk::IdentifierType k = 0; k < 12; ++k)
+  {
+    PointType p = icosahedron->GetPoint(k);
+    for (unsigned int d = 0; d < 3; ++d)
+    {
+      p[d] += 0.4 * std::sin(7.0 * k + 2.0 * d);
+    }
+    icosahedron->SetPoint(k, p);
+  }
+  check(icosahedron, "icosahedron", true);
 }
 
 TEST(InternalForces, DiagnosticsAreTheSameWhateverObservesTheFilter)
