@@ -291,7 +291,7 @@ private:
   SampleForce(const ForceSampler & sampler, const Vec4 & xi);
 
   /** SampleForce() times \a scale at vertices [begin, end) (coordinates \a x,
-   * 3 per vertex), into forces[0, end - begin); at most 32 vertices. */
+   * 3 per vertex), into forces[0, end - begin); at most ChunkSize vertices. */
   static EDM_ALWAYS_INLINE void
   SampleForces(const ForceSampler & sampler,
                const double *       x,
@@ -310,13 +310,14 @@ private:
   ComputeGeometry(const double * coordinates, SizeValueType i, Vec4 & u, Vec4 & n) const;
 
   /** Umbrella vectors (and normals) of vertices [begin, end), first pass of
-   * a step with rigidity. */
-  template <bool NeedNormal>
+   * a step with rigidity. Ordered: each chunk in m_ValenceOrder's order. */
+  template <bool NeedNormal, bool Ordered>
   void
   GeometryBlock(SizeValueType begin, SizeValueType end);
 
-  /** The step of vertices [begin, end); returns their largest displacement. */
-  template <bool UseRigidity, bool UseNormal>
+  /** The step of vertices [begin, end); returns their largest displacement.
+   * Ordered: each chunk in m_ValenceOrder's order. */
+  template <bool UseRigidity, bool UseNormal, bool Ordered>
   double
   StepBlock(SizeValueType begin, SizeValueType end, bool diagnose);
 
@@ -354,9 +355,10 @@ private:
   std::vector<IndexType32> m_GeneralPairOffsets;
   std::vector<IndexType32> m_GeneralPairs;
   SizeValueType            m_NumberOfTriangles{ 0 };
-  // Straight-line code for closed rings of 4 to 8 neighbours: when at least
-  // three quarters of the closed-ring vertices share one such valence.
-  bool m_StraightLineRings{ false };
+  // When no number of neighbours is shared by three quarters of the vertices:
+  // for each chunk of ChunkSize vertices, the offsets in the chunk of its
+  // vertices sorted by number of neighbours; empty otherwise.
+  std::vector<uint8_t> m_ValenceOrder;
 
   // Per-vertex state. Next coordinates: 3 per vertex and a guard value, as
   // the cached coordinates they are swapped with; umbrella vectors and

@@ -214,7 +214,7 @@ DeformableMeshFilter<TMesh, TForceImage>::SampleForces(const ForceSampler & samp
     // the corners are then loaded and blended vertex by vertex.
     const char *  bytes = reinterpret_cast<const char *>(sampler.buffer);
     const __m128i lastBytes = _mm_set1_epi32(static_cast<int32_t>(sampler.lastPixel * sizeof(ForcePixelType)));
-    constexpr SizeValueType maximumCount = 32; // the runs of StepBlock()
+    constexpr SizeValueType maximumCount = ChunkSize; // the runs of StepBlock()
     alignas(32) int32_t     corners[8][maximumCount];
     alignas(32) double      weights[3][maximumCount];
     uint32_t                insideBits = 0;
@@ -543,21 +543,42 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology()
   m_OrientationSign = volume < 0.0 ? -1.0 : 1.0;
   m_NumberOfTriangles = numberOfTriangles;
 
-  // Straight-line code per valence pays when the valence rarely changes from
-  // one vertex to the next (regular and subdivided meshes); on meshes of mixed
-  // valences (marching cubes) the mispredicted jumps cost more than the loop.
-  SizeValueType ringCounts[9] = {};
-  SizeValueType closedRings = 0;
+  // The step has straight-line code for 4 to 8 neighbours, chosen by a jump
+  // on the number of neighbours. Where that number varies from vertex to
+  // vertex (marching-cubes meshes) the jumps are mispredicted; there each
+  // chunk of vertices is processed in the order of its numbers of neighbours
+  // (a counting sort, done once here), which changes nothing in the results.
+  std::vector<uint8_t>().swap(m_ValenceOrder);
+  constexpr unsigned int keys = 10; // 0 to 8 neighbours, and more
+  const auto             keyOf = [this](SizeValueType i) {
+    return std::min<IndexType32>(keys - 1, m_NeighbourOffsets[i + 1] - m_NeighbourOffsets[i]);
+  };
+  SizeValueType histogram[keys] = {};
   for (SizeValueType i = 0; i < numberOfPoints; ++i)
   {
-    if (m_RingKinds[i] == ClosedRing)
+    ++histogram[keyOf(i)];
+  }
+  if (4 * *std::max_element(histogram, histogram + keys) < 3 * numberOfPoints)
+  {
+    m_ValenceOrder.resize(numberOfPoints);
+    for (SizeValueType chunkBegin = 0; chunkBegin < numberOfPoints; chunkBegin += DeformableMeshFilterDetail::ChunkSize)
     {
-      ++closedRings;
-      ++ringCounts[std::min<IndexType32>(8, m_NeighbourOffsets[i + 1] - m_NeighbourOffsets[i])];
+      const SizeValueType chunkEnd = std::min(numberOfPoints, chunkBegin + DeformableMeshFilterDetail::ChunkSize);
+      unsigned int        next[keys + 1] = {};
+      for (SizeValueType i = chunkBegin; i < chunkEnd; ++i)
+      {
+        ++next[keyOf(i) + 1];
+      }
+      for (unsigned int k = 1; k <= keys; ++k)
+      {
+        next[k] += next[k - 1];
+      }
+      for (SizeValueType i = chunkBegin; i < chunkEnd; ++i)
+      {
+        m_ValenceOrder[chunkBegin + next[keyOf(i)]++] = static_cast<uint8_t>(i - chunkBegin);
+      }
     }
   }
-  const SizeValueType mostCommon = *std::max_element(ringCounts + 4, ringCounts + 9);
-  m_StraightLineRings = closedRings > 0 && 4 * mostCommon >= 3 * closedRings;
 }
 
 template <typename TMesh, typename TForceImage>
@@ -610,7 +631,7 @@ DeformableMeshFilter<TMesh, TForceImage>::ComputeGeometry(const double * x, Size
   // memory) until cleared.
   const Vec4 xi = Load4(x + 3 * i);
   // Straight-line code for the usual valences.
-  if (kind == ClosedRing && m_StraightLineRings && WithUsualValence(end - begin, [&](auto valence) {
+  if (kind == ClosedRing && WithUsualValence(end - begin, [&](auto valence) {
         ClosedRingGeometry<decltype(valence)::value, NeedNormal>(x, ring + begin, xi, u, n);
       }))
   {
@@ -764,8 +785,10 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
                         this->HasObserver(IterationEvent()) || this->HasObserver(ProgressEvent());
 
   constexpr SizeValueType blockSize = 512;
-  const SizeValueType     numberOfBlocks = (numberOfPoints + blockSize - 1) / blockSize;
-  MultiThreaderBase *     threader = this->GetMultiThreader();
+  static_assert(blockSize % ChunkSize == 0, "blocks are made of whole chunks");
+  const bool          ordered = !m_ValenceOrder.empty();
+  const SizeValueType numberOfBlocks = (numberOfPoints + blockSize - 1) / blockSize;
+  MultiThreaderBase * threader = this->GetMultiThreader();
   threader->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
 
   // With rigidity, a first pass stores the umbrella vectors (and normals) of
@@ -786,17 +809,14 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
     threader->ParallelizeArray(
       0,
       numberOfBlocks,
-      [this, numberOfPoints, useNormal](SizeValueType block) {
+      [this, numberOfPoints, useNormal, ordered](SizeValueType block) {
         const SizeValueType begin = block * blockSize;
         const SizeValueType end = std::min(numberOfPoints, begin + blockSize);
-        if (useNormal)
-        {
-          this->GeometryBlock<true>(begin, end);
-        }
-        else
-        {
-          this->GeometryBlock<false>(begin, end);
-        }
+        WithConstant(useNormal, [&](auto needNormal) {
+          WithConstant(ordered, [&](auto inOrder) {
+            this->GeometryBlock<decltype(needNormal)::value, decltype(inOrder)::value>(begin, end);
+          });
+        });
       },
       nullptr);
   }
@@ -805,19 +825,18 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   threader->ParallelizeArray(
     0,
     numberOfBlocks,
-    [this, numberOfPoints, useRigidity, useNormal, diagnose, &blockMaximum](SizeValueType block) {
+    [this, numberOfPoints, useRigidity, useNormal, ordered, diagnose, &blockMaximum](SizeValueType block) {
       const SizeValueType begin = block * blockSize;
       const SizeValueType end = std::min(numberOfPoints, begin + blockSize);
-      if (useRigidity)
-      {
-        blockMaximum[block] = useNormal ? this->StepBlock<true, true>(begin, end, diagnose)
-                                        : this->StepBlock<true, false>(begin, end, diagnose);
-      }
-      else
-      {
-        blockMaximum[block] = useNormal ? this->StepBlock<false, true>(begin, end, diagnose)
-                                        : this->StepBlock<false, false>(begin, end, diagnose);
-      }
+      WithConstant(useRigidity, [&](auto rigidity) {
+        WithConstant(useNormal, [&](auto normal) {
+          WithConstant(ordered, [&](auto inOrder) {
+            blockMaximum[block] =
+              this->StepBlock<decltype(rigidity)::value, decltype(normal)::value, decltype(inOrder)::value>(
+                begin, end, diagnose);
+          });
+        });
+      });
     },
     nullptr);
 
@@ -835,7 +854,7 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
 }
 
 template <typename TMesh, typename TForceImage>
-template <bool NeedNormal>
+template <bool NeedNormal, bool Ordered>
 void
 DeformableMeshFilter<TMesh, TForceImage>::GeometryBlock(SizeValueType begin, SizeValueType end)
 {
@@ -847,15 +866,17 @@ DeformableMeshFilter<TMesh, TForceImage>::GeometryBlock(SizeValueType begin, Siz
   // The normals of a chunk of vertices are scaled to unit length after the
   // chunk: the square roots and divisions then overlap across vertices
   // instead of ending each vertex's chain of dependent operations.
-  constexpr SizeValueType chunk = 32;
+  constexpr SizeValueType chunk = ChunkSize;
   Vec4                    normals[chunk];
+  const uint8_t *         order = m_ValenceOrder.data();
   for (SizeValueType chunkBegin = begin; chunkBegin < end; chunkBegin += chunk)
   {
     const SizeValueType chunkEnd = std::min(end, chunkBegin + chunk);
-    for (SizeValueType i = chunkBegin; i < chunkEnd; ++i)
+    for (SizeValueType k = chunkBegin; k < chunkEnd; ++k)
     {
-      Vec4 u;
-      Vec4 n;
+      const SizeValueType i = Ordered ? chunkBegin + order[k] : k;
+      Vec4                u;
+      Vec4                n;
       this->template ComputeGeometry<NeedNormal>(x, i, u, n);
       StoreFloat4(umbrellaField + 4 * i, u);
       if (NeedNormal)
@@ -877,7 +898,7 @@ DeformableMeshFilter<TMesh, TForceImage>::GeometryBlock(SizeValueType begin, Siz
 }
 
 template <typename TMesh, typename TForceImage>
-template <bool UseRigidity, bool UseNormal>
+template <bool UseRigidity, bool UseNormal, bool Ordered>
 double
 DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeValueType end, bool diagnose)
 {
@@ -895,7 +916,7 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
   const double        balloon = m_Balloon;
   const double        maximumStep = m_MaximumStepLength;
   const double        orientationSign = m_OrientationSign;
-  const bool          straightLineRings = m_StraightLineRings;
+  const uint8_t *     order = m_ValenceOrder.data();
   const ForceSampler  sampler = m_Sampler;
   const double *      x = this->GetCoordinates().data();
   double *            next = m_NextCoordinates.data();
@@ -911,7 +932,7 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
   // The external forces of a run of vertices first, then the rest: two short
   // loop bodies whose long dependency chains (index, voxel loads,
   // interpolation; neighbour loads, normal) overlap across vertices.
-  constexpr SizeValueType run = 32;
+  constexpr SizeValueType run = ChunkSize;
   Vec4                    externalForces[run];
   double                  squaredSteps[run];
   double                  largest = 0.0; // squared
@@ -919,12 +940,13 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
   {
     const SizeValueType runEnd = std::min(end, runBegin + run);
     SampleForces(sampler, x, runBegin, runEnd, scaleFactor, externalForces);
-    for (SizeValueType i = runBegin; i < runEnd; ++i)
+    for (SizeValueType k = runBegin; k < runEnd; ++k)
     {
-      const Vec4 xi = Load4(x + 3 * i);
-      Vec4       u{};
-      Vec4       n{};
-      Vec4       internal{};
+      const SizeValueType i = Ordered ? runBegin + order[k] : k;
+      const Vec4          xi = Load4(x + 3 * i);
+      Vec4                u{};
+      Vec4                n{};
+      Vec4                internal{};
       if (UseRigidity)
       {
         u = LoadFloat4(umbrellaField + 4 * i);
@@ -937,7 +959,7 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
         if (stop > first)
         {
           Vec4 sum{};
-          if (!straightLineRings || !WithUsualValence(stop - first, [&](auto valence) {
+          if (!WithUsualValence(stop - first, [&](auto valence) {
                 sum = GatherSum<decltype(valence)::value>(umbrellaField, neighbours + first);
               }))
           {
@@ -995,8 +1017,9 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
         }
       }
       // A 4-wide store spills into the next point's first coordinate, which the
-      // next iteration of this loop overwrites; not at the block's end.
-      if (i + 1 < end)
+      // next iteration of this loop overwrites; not at the block's end, nor
+      // when the vertices are not processed in order.
+      if (!Ordered && i + 1 < end)
       {
         Store4(next + 3 * i, xi + delta);
       }
@@ -1047,7 +1070,7 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "OrientationSign: " << m_OrientationSign << std::endl;
   os << indent << "Neighbours: " << m_Neighbours.size() << " entries, Triangles: " << m_NumberOfTriangles
      << ", vertices outside a single fan: " << m_GeneralVertices.size() << std::endl;
-  os << indent << "StraightLineRings: " << (m_StraightLineRings ? "On" : "Off") << std::endl;
+  os << indent << "OrderedByValence: " << (m_ValenceOrder.empty() ? "Off" : "On") << std::endl;
   os << indent << "ForceBuffer: " << m_ForceBuffer << std::endl;
   os << indent << "PhysicalToIndex: [" << m_PhysicalToIndex[0][0] << ' ' << m_PhysicalToIndex[0][1] << ' '
      << m_PhysicalToIndex[0][2] << "; " << m_PhysicalToIndex[1][0] << ' ' << m_PhysicalToIndex[1][1] << ' '

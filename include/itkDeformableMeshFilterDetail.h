@@ -404,12 +404,33 @@ struct PixelLoader<TPixel, true>
   }
 };
 
+/** Vertices in a chunk of the step: the forces of a run of this many are
+ * sampled together, the normals of a chunk are scaled together, and on meshes
+ * of mixed valences the vertices of a chunk are ordered by valence. */
+constexpr std::size_t ChunkSize = 32;
+
 /** n / |n| times sign (lane 3 of n must be 0); 0 when n is 0. */
 EDM_ALWAYS_INLINE Vec4
 UnitVector(const Vec4 & n, double sign)
 {
   const double squaredLength = Dot3(n, n);
   return squaredLength > 0.0 ? n * Splat(sign / std::sqrt(squaredLength)) : Vec4{};
+}
+
+/** Calls f(std::true_type()) or f(std::false_type()) as \a value: a run-time
+ * flag turned into a template argument. */
+template <typename TFunction>
+EDM_ALWAYS_INLINE void
+WithConstant(bool value, TFunction && f)
+{
+  if (value)
+  {
+    f(std::true_type());
+  }
+  else
+  {
+    f(std::false_type());
+  }
 }
 
 /** For a count of 4 to 8 (the usual valences), calls

@@ -25,6 +25,7 @@
 // the ellipsoid's normal, triangle angles.
 
 #include "itkAdditiveGaussianNoiseImageFilter.h"
+#include "itkBinaryMask3DMeshSource.h"
 #include "itkDeformableMeshFilter.h"
 #include "itkEllipsoidPhantom.h"
 #include "itkExternalForceImageFilter.h"
@@ -644,14 +645,14 @@ GeneralVertexCount(const FilterType * filter)
   return where == std::string::npos ? size_t(-1) : std::stoul(text.substr(where + key.size()));
 }
 
-/** Whether the filter uses its straight-line code for closed rings, read from
- * its Print() output. */
+/** Whether the filter processes the vertices of each chunk in the order of
+ * their numbers of neighbours, read from its Print() output. */
 bool
-StraightLineRings(const FilterType * filter)
+OrderedByValence(const FilterType * filter)
 {
   std::ostringstream os;
   filter->Print(os);
-  return os.str().find("StraightLineRings: On") != std::string::npos;
+  return os.str().find("OrderedByValence: On") != std::string::npos;
 }
 } // namespace
 
@@ -790,14 +791,14 @@ TEST(InternalForces, OneStepMatchesTheDefinitionsOnClosedOpenAndIrregularVertice
 TEST(InternalForces, OneStepMatchesTheDefinitionsWhateverTheValence)
 {
   const auto field = ZeroForceField();
-  const auto check = [&field](const MeshType * mesh, const std::string & name, bool straightLine) {
+  const auto check = [&field](const MeshType * mesh, const std::string & name, bool ordered) {
     for (const double rigidity : { 0.0, 0.2 })
     {
       double     largestError = 0.0;
       const auto filter = OneStep(mesh, field, rigidity, largestError);
       ASSERT_EQ(filter->GetOrientationSign(), 1.0) << name;
       EXPECT_EQ(GeneralVertexCount(filter), 0u) << name;
-      EXPECT_EQ(StraightLineRings(filter), straightLine) << name;
+      EXPECT_EQ(OrderedByValence(filter), ordered) << name;
       EXPECT_LT(largestError, rigidity > 0.0 ? 1e-6 : 1e-12) << name << ", rigidity " << rigidity;
     }
   };
@@ -813,9 +814,9 @@ TEST(InternalForces, OneStepMatchesTheDefinitionsWhateverTheValence)
 
   // Irregular bipyramids: two apexes of valence K (a closed ring of K
   // neighbours) around a ring of K vertices of valence 4. K from 3 to 12
-  // covers the valences with straight-line code and those without; the
-  // filter uses that code when three quarters of the vertices share a
-  // valence (here valence 4 from K = 6 on, and all of them for K = 4).
+  // covers the valences with straight-line code and those without. The
+  // filter orders the vertices by valence when no valence is shared by three
+  // quarters of them: here for K = 3 and 5.
   for (unsigned int K = 3; K <= 12; ++K)
   {
     auto      mesh = MeshType::New();
@@ -844,7 +845,7 @@ TEST(InternalForces, OneStepMatchesTheDefinitionsWhateverTheValence)
       addTriangle(mesh, 2 * k, { 0, a, b });
       addTriangle(mesh, 2 * k + 1, { 1, b, a });
     }
-    check(mesh, "bipyramid K " + std::to_string(K), K == 4 || K >= 6);
+    check(mesh, "bipyramid K " + std::to_string(K), K == 3 || K == 5);
   }
 
   // An irregular icosahedron: every vertex of valence 5.
@@ -899,7 +900,29 @@ TEST(InternalForces, OneStepMatchesTheDefinitionsWhateverTheValence)
     }
     icosahedron->SetPoint(k, p);
   }
-  check(icosahedron, "icosahedron", true);
+  check(icosahedron, "icosahedron", false);
+
+  // A marching-cubes mesh of a ball: mixed valences over many chunks.
+  using MaskType = itk::Image<unsigned char, 3>;
+  auto               mask = MaskType::New();
+  MaskType::SizeType maskSize;
+  maskSize.Fill(24);
+  mask->SetRegions(maskSize);
+  mask->Allocate();
+  for (itk::ImageRegionIteratorWithIndex<MaskType> it(mask, mask->GetBufferedRegion()); !it.IsAtEnd(); ++it)
+  {
+    const auto   index = it.GetIndex();
+    const double x = index[0] - 11.3;
+    const double y = index[1] - 12.1;
+    const double z = index[2] - 11.7;
+    it.Set(x * x / 64.0 + y * y / 36.0 + z * z / 49.0 < 1.0 ? 1 : 0);
+  }
+  auto marchingCubes = itk::BinaryMask3DMeshSource<MaskType, MeshType>::New();
+  marchingCubes->SetInput(mask);
+  marchingCubes->SetObjectValue(1);
+  marchingCubes->Update();
+  ASSERT_GT(marchingCubes->GetOutput()->GetNumberOfPoints(), 10 * itk::DeformableMeshFilterDetail::ChunkSize);
+  check(marchingCubes->GetOutput(), "marching cubes", true);
 }
 
 TEST(InternalForces, DiagnosticsAreTheSameWhateverObservesTheFilter)
