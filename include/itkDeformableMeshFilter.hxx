@@ -246,7 +246,8 @@ DeformableMeshFilter<TMesh, TForceImage>::SampleForces(const ForceSampler & samp
       __m128i       high[3];
       for (unsigned int k = 0; k < 3; ++k)
       {
-        // The products and sums in the order of SampleForce().
+        // The products and sums in the order GCC gives SampleForce() with FMA:
+        // both paths give the same bits there (checked on 300-step runs).
         __m256d ck = _mm256_mul_pd(_mm256_set1_pd(sampler.columns[1][k]), axis[1]);
         ck = _mm256_fmadd_pd(_mm256_set1_pd(sampler.columns[0][k]), axis[0], ck);
         ck = _mm256_fmadd_pd(_mm256_set1_pd(sampler.columns[2][k]), axis[2], ck);
