@@ -330,6 +330,21 @@ private:
   void
   ComputeGeneralGeometry(const double * coordinates, SizeValueType i, Vec4 & u, Vec4 & n) const;
 
+  /** True when a term of the intensity image (region force, edge search) is
+   * on: the step then adds m_NormalSpeeds along each vertex's unit normal. */
+  bool
+  UsesImageTerms() const
+  {
+    return false;
+  }
+
+  /** Fills m_NormalSpeeds (outward speed of each vertex, mm per iteration)
+   * from the intensity image, at the current coordinates and the unit
+   * normals m_Normals of the geometry pass. */
+  void
+  UpdateNormalSpeeds()
+  {}
+
   double       m_ScaleFactor{ 1.0 };
   double       m_Elasticity{ 0.0 };
   bool         m_TangentialElasticity{ true };
@@ -367,6 +382,7 @@ private:
   std::vector<float>   m_Umbrella;
   std::vector<float>   m_Normals;
   std::vector<uint8_t> m_BalloonReleased;
+  std::vector<float>   m_NormalSpeeds; // image terms only
   std::vector<float>   m_DisplacementMagnitudes;
   std::vector<float>   m_ExternalForceMagnitudes;
   std::vector<float>   m_InternalForceMagnitudes;

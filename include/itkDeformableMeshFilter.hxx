@@ -763,8 +763,11 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   const SizeValueType   numberOfPoints = this->GetNumberOfCachedPoints();
 
   const bool useElasticity = m_Elasticity > 0.0;
-  const bool useRigidity = m_Rigidity > 0.0;
-  const bool useNormal = m_Balloon != 0.0 || (useElasticity && m_TangentialElasticity);
+  // Image terms (region force, edge search) need the current unit normals
+  // before the step: the geometry pass stores them, as for rigidity.
+  const bool useImageTerms = this->UsesImageTerms();
+  const bool useRigidity = m_Rigidity > 0.0 || useImageTerms;
+  const bool useNormal = m_Balloon != 0.0 || (useElasticity && m_TangentialElasticity) || useImageTerms;
 
   if (m_DisplacementMagnitudes.size() != numberOfPoints)
   {
@@ -820,6 +823,14 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
         });
       },
       nullptr);
+  }
+  if (useImageTerms)
+  {
+    this->UpdateNormalSpeeds();
+  }
+  else
+  {
+    m_NormalSpeeds.clear();
   }
 
   std::vector<double> blockMaximum(numberOfBlocks, 0.0);
@@ -926,6 +937,7 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
   const IndexType32 * offsets = m_NeighbourOffsets.data();
   const IndexType32 * neighbours = m_Neighbours.data();
   uint8_t *           balloonReleased = m_BalloonReleased.data();
+  const float *       normalSpeeds = m_NormalSpeeds.empty() ? nullptr : m_NormalSpeeds.data();
   float *             displacementMagnitudes = m_DisplacementMagnitudes.data();
   float *             externalMagnitudes = m_ExternalForceMagnitudes.data();
   float *             internalMagnitudes = m_InternalForceMagnitudes.data();
@@ -1003,6 +1015,10 @@ DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeVal
         {
           inflation = balloon;
         }
+      }
+      if (UseNormal && normalSpeeds != nullptr)
+      {
+        inflation += normalSpeeds[i];
       }
       Vec4 delta = external + internal;
       if (UseNormal)
