@@ -21,6 +21,7 @@
 #include "itkIterativeMeshFilter.h"
 #include "itkImage.h"
 #include "itkDeformableMeshFilterDetail.h"
+#include "itkForceImageCheck.h"
 
 #include <cstdint>
 #include <vector>
@@ -353,6 +354,8 @@ private:
   double       m_MaximumStepLength{ 0.0 };
   double       m_ConvergenceTolerance{ 0.0 };
   unsigned int m_ConvergenceWindow{ 3 };
+  /** Finite values and step bound of the force image (bad input). */
+  ForceImageCheck<ForceImageType> m_ForceImageCheck;
 
   bool         m_Converged{ false };
   unsigned int m_QuietIterations{ 0 };

@@ -77,6 +77,7 @@ void
 DeformableMeshFilter<TMesh, TForceImage>::GenerateData()
 {
   this->PrepareForceSampler();
+  m_ForceImageCheck.Verify(this->GetForceImage(), m_ScaleFactor, m_Balloon, m_MaximumStepLength);
   Superclass::GenerateData();
 }
 

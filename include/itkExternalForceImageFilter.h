@@ -19,6 +19,7 @@
 #define itkExternalForceImageFilter_h
 
 #include "itkGradientImageFilter.h"
+#include "itkExplicitDeformableModelCompatibility.h"
 
 namespace itk
 {
@@ -61,6 +62,13 @@ namespace itk
  * Without normalisation the output is in intensity units per squared physical
  * unit.
  *
+ * Bad input is an ExceptionObject, never a non-finite output: an input pixel
+ * that is NaN or infinite, a Sigma beyond the image's extent, a raw field that
+ * does not fit the output pixel type, and a failed memory allocation (the
+ * message gives the size needed). Intensities of any finite magnitude (up to
+ * the largest float or double, down to denormals) give the same normalised
+ * field: they are scaled by a power of two before the derivatives.
+ *
  * \sa DeformableMeshFilter, GradientImageFilter
  * \ingroup ExplicitDeformableModel
  */
@@ -89,7 +97,7 @@ public:
   itkNewMacro(Self);
 
   /** Run-time type information (and related methods). */
-  itkTypeMacro(ExternalForceImageFilter, GradientImageFilter);
+  itkOverrideGetNameOfClassMacro(ExternalForceImageFilter);
 
   static constexpr unsigned int ImageDimension = TInputImage::ImageDimension;
 
@@ -102,7 +110,9 @@ public:
   /** Standard deviation of the Gaussian smoothing, in physical units (mm for
    * medical images). It sets the capture range of the plain gradient force
    * (about 2 to 3 Sigma on each side of an edge). 0 disables smoothing.
-   * Must be finite and non-negative. Default: 1.0. */
+   * Must be finite, non-negative and at most the largest physical extent of
+   * the input image (beyond it the smoothed image has no edge left); the
+   * update throws an ExceptionObject otherwise. Default: 1.0. */
   itkSetMacro(Sigma, double);
   itkGetConstMacro(Sigma, double);
 
@@ -142,7 +152,7 @@ protected:
   PrintSelf(std::ostream & os, Indent indent) const override;
 
   void
-  VerifyPreconditions() ITKv5_CONST override;
+  VerifyPreconditions() const override;
 
   void
   EnlargeOutputRequestedRegion(DataObject * output) override;
@@ -151,6 +161,15 @@ protected:
   GenerateData() override;
 
 private:
+  /** GenerateData() without the checks and the conversion of std::bad_alloc. */
+  void
+  ComputeForceField(const InputImageType * input);
+
+  /** Sum of exp(-k^2 / (2 sigma^2)) for the integers k from \a first to
+   * \a last: the taps of the Gaussian folded onto the border pixels. */
+  static double
+  GaussianTailSum(double first, double last, double sigma);
+
   /** The input as floats, smoothed by a Gaussian of standard deviation Sigma
    * (physical units): separable, sampled and truncated at 4 Sigma along each
    * axis, border pixels repeated, threaded over lines and rows of pixels. */
@@ -188,6 +207,9 @@ private:
   bool         m_UseGradientVectorFlow{ false };
   double       m_GradientVectorFlowRegularization{ 0.1 };
   unsigned int m_GradientVectorFlowIterations{ 400 };
+  /** The intensities are divided by 2^m_IntensityExponent on conversion to
+   * float (0 for magnitudes between 2^-40 and 2^40). */
+  int m_IntensityExponent{ 0 };
 };
 } // end namespace itk
 

@@ -21,8 +21,12 @@
 #include "itkExternalForceImageFilter.h"
 #include "itkMultiThreaderBase.h"
 
+#include "itkMath.h"
+
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <new>
 #include <vector>
 
 namespace itk
@@ -30,7 +34,7 @@ namespace itk
 
 template <typename TInputImage, typename TOutputImage>
 void
-ExternalForceImageFilter<TInputImage, TOutputImage>::VerifyPreconditions() ITKv5_CONST
+ExternalForceImageFilter<TInputImage, TOutputImage>::VerifyPreconditions() const
 {
   Superclass::VerifyPreconditions();
   if (!(m_Sigma >= 0.0 && std::isfinite(m_Sigma)))
@@ -72,6 +76,7 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::GenerateData()
   {
     itkExceptionMacro("The input image has no pixel in its buffered region.");
   }
+  double largestExtent = 0.0;
   for (unsigned int d = 0; d < ImageDimension; ++d)
   {
     if (input->GetLargestPossibleRegion().GetSize()[d] < 4)
@@ -79,8 +84,36 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::GenerateData()
       itkExceptionMacro("The input image must have at least 4 pixels along each axis; its size is "
                         << input->GetLargestPossibleRegion().GetSize() << ".");
     }
+    largestExtent = std::max(
+      largestExtent, static_cast<double>(input->GetLargestPossibleRegion().GetSize()[d]) * input->GetSpacing()[d]);
   }
+  // Beyond the image's extent the smoothed image is flat: no edge is left to
+  // pull a mesh, and the kernel's size would be unbounded.
+  if (!(m_Sigma <= largestExtent))
+  {
+    itkExceptionMacro("Sigma (" << m_Sigma << ") exceeds the largest physical extent of the input image ("
+                                << largestExtent << "): the smoothed image would have no edge.");
+  }
+  const SizeValueType numberOfPixels = input->GetBufferedRegion().GetNumberOfPixels();
+  try
+  {
+    this->ComputeForceField(input);
+  }
+  catch (const std::bad_alloc &)
+  {
+    // The float images of the smoothing, edge map and field, and the arrays
+    // of the diffusion.
+    const double bytesPerPixel = 3.0 * sizeof(float) + sizeof(OutputPixelType) +
+                                 (m_UseGradientVectorFlow ? sizeof(float) + 3.0 * sizeof(OutputPixelType) : 0.0);
+    itkExceptionMacro("Out of memory: the force field of an image of "
+                      << numberOfPixels << " pixels needs about " << bytesPerPixel * numberOfPixels / 1e6 << " MB.");
+  }
+}
 
+template <typename TInputImage, typename TOutputImage>
+void
+ExternalForceImageFilter<TInputImage, TOutputImage>::ComputeForceField(const InputImageType * input)
+{
   typename RealImageType::Pointer smoothed = this->Smooth(input);
   this->UpdateProgress(0.3f);
 
@@ -140,11 +173,11 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::GenerateData()
     this->DiffuseGradientVectorFlow(field);
   }
 
+  OutputPixelType *   f = field->GetBufferPointer();
+  const SizeValueType n = field->GetBufferedRegion().GetNumberOfPixels();
   if (m_NormalizeForces)
   {
-    OutputPixelType *   f = field->GetBufferPointer();
-    const SizeValueType n = field->GetBufferedRegion().GetNumberOfPixels();
-    double              largest = 0.0;
+    double largest = 0.0;
     for (SizeValueType i = 0; i < n; ++i)
     {
       largest = std::max(largest, static_cast<double>(f[i].GetSquaredNorm()));
@@ -155,6 +188,30 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::GenerateData()
       for (SizeValueType i = 0; i < n; ++i)
       {
         f[i] *= scale;
+      }
+    }
+  }
+  else if (m_IntensityExponent != 0 && !m_UseGradientVectorFlow)
+  {
+    // Raw forces are linear in the intensities: undo the scaling of Smooth().
+    for (SizeValueType i = 0; i < n; ++i)
+    {
+      for (unsigned int k = 0; k < OutputPixelType::Dimension; ++k)
+      {
+        f[i][k] = static_cast<OutputValueType>(std::ldexp(static_cast<double>(f[i][k]), m_IntensityExponent));
+      }
+    }
+  }
+  for (SizeValueType i = 0; i < n; ++i)
+  {
+    for (unsigned int k = 0; k < OutputPixelType::Dimension; ++k)
+    {
+      if (!std::isfinite(static_cast<double>(f[i][k])))
+      {
+        itkExceptionMacro("The force at index " << field->ComputeIndex(static_cast<OffsetValueType>(i))
+                                                << " is not finite (" << f[i][k]
+                                                << "): the raw forces exceed the range of the output pixel type; "
+                                                   "turn NormalizeForces on.");
       }
     }
   }
@@ -183,8 +240,49 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::Smooth(const InputImageType
 
   typename RealImageType::Pointer current = makeImage();
   {
-    const auto * in = input->GetBufferPointer();
-    float *      out = current->GetBufferPointer();
+    // The largest |intensity| and the first non-finite pixel, chunk by chunk.
+    const auto *        in = input->GetBufferPointer();
+    std::vector<double> largest(numberOfChunks, 0.0);
+    std::vector<double> firstNonFinite(numberOfChunks, -1.0);
+    threader->ParallelizeArray(
+      0,
+      numberOfChunks,
+      [&](SizeValueType c) {
+        const SizeValueType end = std::min(numberOfPixels, (c + 1) * chunk);
+        double              m = 0.0;
+        for (SizeValueType i = c * chunk; i < end; ++i)
+        {
+          const double v = std::abs(static_cast<double>(in[i]));
+          if (!(v <= std::numeric_limits<double>::max()))
+          {
+            firstNonFinite[c] = static_cast<double>(i);
+            break;
+          }
+          m = std::max(m, v);
+        }
+        largest[c] = m;
+      },
+      nullptr);
+    for (SizeValueType c = 0; c < numberOfChunks; ++c)
+    {
+      if (firstNonFinite[c] >= 0.0)
+      {
+        const auto offset = static_cast<OffsetValueType>(firstNonFinite[c]);
+        itkExceptionMacro("The input image has a non-finite value (" << static_cast<double>(in[offset]) << ") at index "
+                                                                     << input->ComputeIndex(offset) << ".");
+      }
+    }
+    // Intensities far from 1 are scaled by a power of two (exact in floating
+    // point) so that the squared derivatives neither overflow nor underflow in
+    // float; the normalised field is the same, raw forces are scaled back.
+    const double largestIntensity = *std::max_element(largest.begin(), largest.end());
+    m_IntensityExponent = 0;
+    if (largestIntensity > 0.0 && (largestIntensity > 0x1p40 || largestIntensity < 0x1p-40))
+    {
+      m_IntensityExponent = std::ilogb(largestIntensity);
+    }
+    const int exponent = m_IntensityExponent;
+    float *   out = current->GetBufferPointer();
     threader->ParallelizeArray(
       0,
       numberOfChunks,
@@ -192,7 +290,8 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::Smooth(const InputImageType
         const SizeValueType end = std::min(numberOfPixels, (c + 1) * chunk);
         for (SizeValueType i = c * chunk; i < end; ++i)
         {
-          out[i] = static_cast<float>(in[i]);
+          out[i] = static_cast<float>(exponent == 0 ? static_cast<double>(in[i])
+                                                    : std::ldexp(static_cast<double>(in[i]), -exponent));
         }
       },
       nullptr);
@@ -216,20 +315,27 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::Smooth(const InputImageType
       inner *= n;
       continue;
     }
-    // Sampled Gaussian truncated at 4 sigma, normalised to a unit sum.
-    const auto         radius = static_cast<SizeValueType>(std::ceil(4.0 * sigma));
-    std::vector<float> weights(radius + 1);
-    double             sum = 0.0;
+    // Sampled Gaussian truncated at 4 sigma, normalised to a unit sum. Taps
+    // at n pixels or more fall beyond both ends of every line, where the
+    // border pixels repeat: they are folded into one tail weight applied to
+    // the two end pixels, so that the cost stays within n taps.
+    const double        fullRadius = std::ceil(4.0 * sigma);
+    const SizeValueType radius = fullRadius < static_cast<double>(n) ? static_cast<SizeValueType>(fullRadius) : n - 1;
+    std::vector<float>  weights(radius + 1);
+    double              sum = 0.0;
     for (SizeValueType k = 0; k <= radius; ++k)
     {
-      const double w = std::exp(-0.5 * static_cast<double>(k * k) / (sigma * sigma));
+      const double w = std::exp(-0.5 * static_cast<double>(k) * static_cast<double>(k) / (sigma * sigma));
       weights[k] = static_cast<float>(w);
       sum += k == 0 ? w : 2.0 * w;
     }
+    const double tailSum = GaussianTailSum(static_cast<double>(radius) + 1.0, fullRadius, sigma);
+    sum += 2.0 * tailSum;
     for (float & w : weights)
     {
       w = static_cast<float>(w / sum);
     }
+    const auto    tail = static_cast<float>(tailSum / sum);
     const float * src = current->GetBufferPointer();
     float *       dst = other->GetBufferPointer();
     // Border pixels repeated beyond the image (zero flux).
@@ -252,6 +358,10 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::Smooth(const InputImageType
             for (SizeValueType k = 1; k <= radius; ++k)
             {
               value += weights[k] * (in[clamped(p, k, false)] + in[clamped(p, k, true)]);
+            }
+            if (tail > 0.0f)
+            {
+              value += tail * (in[0] + in[n - 1]);
             }
             out[p] = value;
           };
@@ -304,6 +414,15 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::Smooth(const InputImageType
               out[i] += w * (below[i] + above[i]);
             }
           }
+          if (tail > 0.0f)
+          {
+            const float * first = base;
+            const float * last = base + (n - 1) * inner;
+            for (SizeValueType i = 0; i < inner; ++i)
+            {
+              out[i] += tail * (first[i] + last[i]);
+            }
+          }
         },
         nullptr);
     }
@@ -311,6 +430,31 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::Smooth(const InputImageType
     inner *= n;
   }
   return current;
+}
+
+template <typename TInputImage, typename TOutputImage>
+double
+ExternalForceImageFilter<TInputImage, TOutputImage>::GaussianTailSum(double first, double last, double sigma)
+{
+  if (!(first <= last))
+  {
+    return 0.0;
+  }
+  const auto gaussian = [sigma](double k) { return std::exp(-0.5 * (k / sigma) * (k / sigma)); };
+  if (last - first < 1e6)
+  {
+    double sum = 0.0;
+    for (double k = first; k <= last; k += 1.0)
+    {
+      sum += gaussian(k);
+    }
+    return sum;
+  }
+  // Euler-Maclaurin: the integral plus half the end terms; with sigma above
+  // 1e5 pixels the neglected terms are far below float precision.
+  const double scale = 1.0 / (sigma * std::sqrt(2.0));
+  return sigma * std::sqrt(0.5 * itk::Math::pi) * (std::erf(last * scale) - std::erf(first * scale)) +
+         0.5 * (gaussian(first) + gaussian(last));
 }
 
 template <typename TInputImage, typename TOutputImage>
@@ -482,6 +626,7 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::PrintSelf(std::ostream & os
   os << indent << "UseGradientVectorFlow: " << (m_UseGradientVectorFlow ? "On" : "Off") << std::endl;
   os << indent << "GradientVectorFlowRegularization: " << m_GradientVectorFlowRegularization << std::endl;
   os << indent << "GradientVectorFlowIterations: " << m_GradientVectorFlowIterations << std::endl;
+  os << indent << "IntensityExponent: " << m_IntensityExponent << std::endl;
 }
 
 } // end namespace itk

@@ -19,6 +19,7 @@
 #define itkIterativeMeshFilter_h
 
 #include "itkMeshToMeshFilter.h"
+#include "itkExplicitDeformableModelCompatibility.h"
 
 #include <vector>
 
@@ -73,7 +74,7 @@ public:
   using ConstPointer = SmartPointer<const Self>;
 
   /** Run-time type information (and related methods). */
-  itkTypeMacro(IterativeMeshFilter, MeshToMeshFilter);
+  itkOverrideGetNameOfClassMacro(IterativeMeshFilter);
 
   using InputMeshType = TInputMesh;
   using OutputMeshType = TOutputMesh;
@@ -109,10 +110,13 @@ protected:
 
   /** Rejects a missing input mesh with a clear message. */
   void
-  VerifyPreconditions() ITKv5_CONST override;
+  VerifyPreconditions() const override;
 
   /** Checks the input mesh (present, not empty, identifiers 0..N-1, finite
-   * coordinates), then runs the iteration contract described above. */
+   * coordinates), then runs the iteration contract described above. A
+   * non-finite coordinate after a step throws an ExceptionObject naming the
+   * iteration (the output is not updated, the next update restarts from the
+   * input); so does a failed memory allocation (std::bad_alloc). */
   void
   GenerateData() override;
 
@@ -162,6 +166,15 @@ protected:
 private:
   using OutputCellsContainer = typename OutputMeshType::CellsContainer;
 
+  /** GenerateData() without the conversion of std::bad_alloc. */
+  void
+  RunIterations();
+
+  /** Throws the ExceptionObject of a diverged step, naming the first
+   * non-finite point and the iterations of this update. */
+  [[noreturn]] void
+  ThrowNonFiniteCoordinate(SizeValueType firstIteration);
+
   void
   CacheInput();
 
@@ -177,6 +190,7 @@ private:
   ModifiedTimeType    m_CachedInputTime{ 0 };
   std::vector<double> m_Coordinates;
   SizeValueType       m_NumberOfCachedPoints{ 0 };
+  bool                m_OutputPointsFinite{ true };
 
   // The output's structure and points, reused from one update to the next:
   // cloning the cells at every update costs more than a step on large meshes.

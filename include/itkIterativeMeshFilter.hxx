@@ -22,6 +22,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <new>
 
 namespace itk
 {
@@ -53,7 +54,7 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::ReleaseOutputCells()
 
 template <typename TInputMesh, typename TOutputMesh>
 void
-IterativeMeshFilter<TInputMesh, TOutputMesh>::VerifyPreconditions() ITKv5_CONST
+IterativeMeshFilter<TInputMesh, TOutputMesh>::VerifyPreconditions() const
 {
   if (this->GetInput() == nullptr)
   {
@@ -99,6 +100,43 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::CacheInput()
 template <typename TInputMesh, typename TOutputMesh>
 void
 IterativeMeshFilter<TInputMesh, TOutputMesh>::GenerateData()
+{
+  try
+  {
+    this->RunIterations();
+  }
+  catch (const std::bad_alloc &)
+  {
+    m_Cached = false;
+    const SizeValueType numberOfPoints = this->GetInput()->GetNumberOfPoints();
+    itkExceptionMacro("Out of memory while deforming a mesh of "
+                      << numberOfPoints << " points (the filter holds a few hundred bytes per point, about "
+                      << 300.0 * numberOfPoints / 1e6 << " MB, besides the input and output meshes).");
+  }
+}
+
+template <typename TInputMesh, typename TOutputMesh>
+void
+IterativeMeshFilter<TInputMesh, TOutputMesh>::ThrowNonFiniteCoordinate(SizeValueType firstIteration)
+{
+  // The next update starts again from the input.
+  m_Cached = false;
+  const SizeValueType n = this->GetNumberOfCachedPoints() * PointDimension;
+  SizeValueType       i = 0;
+  while (i < n && std::isfinite(m_Coordinates[i]))
+  {
+    ++i;
+  }
+  itkExceptionMacro("Point #" << i / PointDimension << " has a non-finite coordinate (" << m_Coordinates[std::min(i, n)]
+                              << ") after iteration " << m_CurrentIteration << " (this update ran iterations "
+                              << firstIteration + 1 << " to " << m_CurrentIteration
+                              << "): the step diverged. Likely causes: a force image holding NaN or infinite "
+                                 "values, or steps so large (scale factor, balloon) that the coordinates overflowed.");
+}
+
+template <typename TInputMesh, typename TOutputMesh>
+void
+IterativeMeshFilter<TInputMesh, TOutputMesh>::RunIterations()
 {
   const InputMeshType * input = this->GetInput();
   if (input == nullptr)
@@ -149,7 +187,12 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::GenerateData()
     ++m_CurrentIteration;
     if (this->HasObserver(IterationEvent()))
     {
+      // Observers never see a non-finite mesh.
       this->UpdateOutputPoints();
+      if (!m_OutputPointsFinite)
+      {
+        this->ThrowNonFiniteCoordinate(firstIteration);
+      }
       this->InvokeEvent(IterationEvent());
     }
     this->UpdateProgress(static_cast<float>((m_CurrentIteration - firstIteration) / iterationsToRun));
@@ -159,6 +202,10 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::GenerateData()
     }
   }
   this->UpdateOutputPoints();
+  if (!m_OutputPointsFinite)
+  {
+    this->ThrowNonFiniteCoordinate(firstIteration);
+  }
 }
 
 template <typename TInputMesh, typename TOutputMesh>
@@ -180,16 +227,21 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::UpdateOutputPoints()
   OutputPointsContainer * points = m_OutputPoints;
   // Through the STL container: ElementAt() calls Modified() for every point,
   // which costs as much as a step of DeformableMeshFilter on large meshes.
+  // The finite check rides on the copy: x * 0 is 0 for a finite x and NaN for
+  // an infinite or NaN one.
   auto &         elements = points->CastToSTLContainer();
   const double * x = m_Coordinates.data();
+  double         check = 0.0;
   for (SizeValueType i = 0; i < numberOfPoints; ++i, x += PointDimension)
   {
     OutputPointType & p = elements[i];
     for (unsigned int d = 0; d < PointDimension; ++d)
     {
       p[d] = static_cast<typename OutputPointType::ValueType>(x[d]);
+      check += x[d] * 0.0;
     }
   }
+  m_OutputPointsFinite = check == 0.0;
   points->Modified();
   output->SetPoints(points);
 }
@@ -207,6 +259,7 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::PrintSelf(std::ostream & os, Inden
   os << indent << "OutputCells: " << (m_OutputCells ? m_OutputCells->Size() : 0) << " shared cells" << std::endl;
   os << indent << "OutputPoints: " << (m_OutputPoints ? m_OutputPoints->Size() : 0) << " reusable points" << std::endl;
   os << indent << "Coordinates: " << this->GetNumberOfCachedPoints() << " cached points" << std::endl;
+  os << indent << "OutputPointsFinite: " << (m_OutputPointsFinite ? "true" : "false") << std::endl;
 }
 
 } // end namespace itk
