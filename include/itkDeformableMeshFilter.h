@@ -75,8 +75,11 @@ namespace itk
  * vertices (polygons, lines, non-manifold fans) keep their triangles in a side
  * table. The force image is read through its buffer with the
  * physical-to-index transform precomputed. The arithmetic works on 3-D vectors
- * held in 4 lanes (AVX when the compiler targets it, else SSE2, else plain
- * doubles). With rigidity, a first pass stores the umbrella vectors and normals
+ * held in 4 lanes. The kernels (itkDeformableMeshFilterKernels.h) are compiled
+ * for AVX2 with FMA, for SSE2 and in plain C++ in one binary, whatever the
+ * compile flags; the fastest one the processor runs is chosen at run time
+ * (the environment variable EDM_KERNEL_PATH, avx2, sse2 or portable, forces
+ * one). With rigidity, a first pass stores the umbrella vectors and normals
  * in single precision, the second computes the displacements. Vertices are
  * processed in fixed blocks over threads, so the output is bit-for-bit
  * identical whatever the number of threads.
@@ -247,89 +250,12 @@ protected:
 
 private:
   using IndexType32 = uint32_t;
-  using Vec4 = DeformableMeshFilterDetail::Vec4;
-
-  /** How the neighbours of a vertex are stored: as the ordered ring of a
-   * closed fan of triangles (interior vertex), as an open fan (boundary
-   * vertex), or unordered with the vertex's triangles kept apart (any other
-   * case: polygons, lines, non-manifold vertices). */
-  enum RingKind : uint8_t
-  {
-    ClosedRing = 0,
-    OpenRing = 1,
-    GeneralVertex = 2
-  };
 
   void
   BuildTopology();
 
   void
   PrepareForceSampler();
-
-  /** What the step reads of the force image; copied to the stack of each
-   * block of vertices, so that the compiler keeps it in registers. */
-  struct ForceSampler
-  {
-    Vec4                   columns[3]; // of the physical-to-continuous-index matrix
-    Vec4                   offset;     // continuous index = columns * x - offset
-    Vec4                   lower;      // inside: lower <= index < upper
-    Vec4                   upper;
-    Vec4                   last;        // (lastX, lastY, lastZ, 0)
-    Vec4                   byteStrides; // bytes from a pixel to the next along x, y, z; 0
-    const ForcePixelType * buffer;
-    bool                   smallBuffer; // byte offsets fit in 32 bits
-    int64_t                lastX;
-    int64_t                lastY;
-    int64_t                lastZ;
-    int64_t                strideY;
-    int64_t                strideZ;
-    int64_t                lastPixel;
-  };
-
-  /** Trilinear sample of the force image at the physical point xi (lane 3
-   * ignored); zero outside the image. Lane 3 of the result is 0. */
-  static EDM_ALWAYS_INLINE Vec4
-  SampleForce(const ForceSampler & sampler, const Vec4 & xi);
-
-  /** SampleForce() times \a scale at vertices [begin, end) (coordinates \a x,
-   * 3 per vertex), into forces[0, end - begin); at most ChunkSize vertices. */
-  static EDM_ALWAYS_INLINE void
-  SampleForces(const ForceSampler & sampler,
-               const double *       x,
-               SizeValueType        begin,
-               SizeValueType        end,
-               double               scale,
-               Vec4 *               forces);
-
-  /** Umbrella vector u (centroid of the neighbours minus the vertex) and,
-   * when NeedNormal, the area-weighted normal n of vertex i: the sum of the
-   * cross products of its triangles' edges from the vertex, neither unit nor
-   * oriented (UnitVector() with m_OrientationSign makes it the outward unit
-   * normal). Lane 3 of both is 0. */
-  template <bool NeedNormal>
-  EDM_ALWAYS_INLINE void
-  ComputeGeometry(const double * coordinates, SizeValueType i, Vec4 & u, Vec4 & n) const;
-
-  /** Umbrella vectors (and normals) of vertices [begin, end), first pass of
-   * a step with rigidity. Ordered: each chunk in m_ValenceOrder's order. */
-  template <bool NeedNormal, bool Ordered>
-  void
-  GeometryBlock(SizeValueType begin, SizeValueType end);
-
-  /** The step of vertices [begin, end); returns their largest displacement.
-   * Ordered: each chunk in m_ValenceOrder's order. */
-  template <bool UseRigidity, bool UseNormal, bool Ordered>
-  double
-  StepBlock(SizeValueType begin, SizeValueType end, bool diagnose);
-
-  /** ComputeGeometry() for a ClosedRing vertex of K neighbours. */
-  template <unsigned int K, bool NeedNormal>
-  static EDM_ALWAYS_INLINE void
-  ClosedRingGeometry(const double * x, const IndexType32 * ring, const Vec4 & xi, Vec4 & u, Vec4 & n);
-
-  /** ComputeGeometry() for a GeneralVertex. */
-  void
-  ComputeGeneralGeometry(const double * coordinates, SizeValueType i, Vec4 & u, Vec4 & n) const;
 
   /** True when a term of the intensity image (region force, edge search) is
    * on: the step then adds m_NormalSpeeds along each vertex's unit normal. */
@@ -397,7 +323,7 @@ private:
   double                 m_ForceOrigin[3]{};
   double                 m_BufferStart[3]{};
   int64_t                m_BufferSize[3]{};
-  ForceSampler           m_Sampler{};
+  DeformableMeshFilterDetail::ForceSampler<ForcePixelType> m_Sampler{};
 };
 } // end namespace itk
 

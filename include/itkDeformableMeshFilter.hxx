@@ -19,6 +19,7 @@
 #define itkDeformableMeshFilter_hxx
 
 #include "itkDeformableMeshFilter.h"
+#include "itkDeformableMeshFilterKernels.h"
 #include "itkMultiThreaderBase.h"
 
 #include <algorithm>
@@ -115,208 +116,41 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareForceSampler()
     m_BufferSize[r] = static_cast<int64_t>(region.GetSize()[r]);
   }
   // Continuous index c = M (x - origin) - start = M x - (M origin + start).
-  ForceSampler & sampler = m_Sampler;
+  DeformableMeshFilterDetail::ForceSampler<ForcePixelType> & sampler = m_Sampler;
   for (unsigned int c = 0; c < 3; ++c)
   {
-    sampler.columns[c] = Vec4{ m_PhysicalToIndex[0][c], m_PhysicalToIndex[1][c], m_PhysicalToIndex[2][c], 0.0 };
+    for (unsigned int r = 0; r < 3; ++r)
+    {
+      sampler.columns[c][r] = m_PhysicalToIndex[r][c];
+    }
   }
-  double offset[3];
   for (unsigned int r = 0; r < 3; ++r)
   {
-    offset[r] = m_PhysicalToIndex[r][0] * m_ForceOrigin[0] + m_PhysicalToIndex[r][1] * m_ForceOrigin[1] +
-                m_PhysicalToIndex[r][2] * m_ForceOrigin[2] + m_BufferStart[r];
+    sampler.offset[r] = m_PhysicalToIndex[r][0] * m_ForceOrigin[0] + m_PhysicalToIndex[r][1] * m_ForceOrigin[1] +
+                        m_PhysicalToIndex[r][2] * m_ForceOrigin[2] + m_BufferStart[r];
+    // Same inside test as itk::LinearInterpolateImageFunction: half a voxel
+    // beyond the first and last voxel centres, values clamped at the border.
+    sampler.lower[r] = -0.5;
+    sampler.upper[r] = static_cast<double>(m_BufferSize[r]) - 0.5;
+    sampler.last[r] = m_BufferSize[r] - 1;
   }
-  sampler.offset = Vec4{ offset[0], offset[1], offset[2], 0.0 };
-  // Same inside test as itk::LinearInterpolateImageFunction: half a voxel
-  // beyond the first and last voxel centres, values clamped at the border.
-  constexpr double infinity = std::numeric_limits<double>::infinity();
-  sampler.lower = Vec4{ -0.5, -0.5, -0.5, -infinity };
-  sampler.upper = Vec4{ static_cast<double>(m_BufferSize[0]) - 0.5,
-                        static_cast<double>(m_BufferSize[1]) - 0.5,
-                        static_cast<double>(m_BufferSize[2]) - 0.5,
-                        infinity };
   sampler.buffer = m_ForceBuffer;
-  sampler.lastX = m_BufferSize[0] - 1;
-  sampler.lastY = m_BufferSize[1] - 1;
-  sampler.lastZ = m_BufferSize[2] - 1;
   sampler.strideY = m_BufferSize[0];
   sampler.strideZ = m_BufferSize[0] * m_BufferSize[1];
   sampler.lastPixel = m_BufferSize[0] * m_BufferSize[1] * m_BufferSize[2] - 1;
-  sampler.last = Vec4{
-    static_cast<double>(sampler.lastX), static_cast<double>(sampler.lastY), static_cast<double>(sampler.lastZ), 0.0
-  };
   constexpr double pixelBytes = sizeof(ForcePixelType);
-  sampler.byteStrides = Vec4{ pixelBytes,
-                              pixelBytes * static_cast<double>(sampler.strideY),
-                              pixelBytes * static_cast<double>(sampler.strideZ),
-                              0.0 };
+  sampler.byteStrides[0] = pixelBytes;
+  sampler.byteStrides[1] = pixelBytes * static_cast<double>(sampler.strideY);
+  sampler.byteStrides[2] = pixelBytes * static_cast<double>(sampler.strideZ);
   sampler.smallBuffer = (sampler.lastPixel + 1) * static_cast<int64_t>(sizeof(ForcePixelType)) <
                         static_cast<int64_t>(std::numeric_limits<int32_t>::max());
-}
-
-template <typename TMesh, typename TForceImage>
-EDM_ALWAYS_INLINE auto
-DeformableMeshFilter<TMesh, TForceImage>::SampleForce(const ForceSampler & sampler, const Vec4 & xi) -> Vec4
-{
-  using namespace DeformableMeshFilterDetail;
-  const Vec4 c = sampler.columns[0] * Splat(xi[0]) + sampler.columns[1] * Splat(xi[1]) +
-                 sampler.columns[2] * Splat(xi[2]) - sampler.offset;
-  if (!InsideBox(c, sampler.lower, sampler.upper))
-  {
-    return Vec4{};
-  }
-  // c >= -0.5, so truncating c + 1 gives floor(c) + 1.
-  const auto    fx = static_cast<int64_t>(c[0] + 1.0) - 1;
-  const auto    fy = static_cast<int64_t>(c[1] + 1.0) - 1;
-  const auto    fz = static_cast<int64_t>(c[2] + 1.0) - 1;
-  const int64_t x0 = std::max<int64_t>(fx, 0);
-  const int64_t x1 = std::min<int64_t>(fx + 1, sampler.lastX);
-  const int64_t y0 = std::max<int64_t>(fy, 0) * sampler.strideY;
-  const int64_t y1 = std::min<int64_t>(fy + 1, sampler.lastY) * sampler.strideY;
-  const int64_t z0 = std::max<int64_t>(fz, 0) * sampler.strideZ;
-  const int64_t z1 = std::min<int64_t>(fz + 1, sampler.lastZ) * sampler.strideZ;
-  const int64_t corners[8] = { z0 + y0 + x0, z0 + y0 + x1, z0 + y1 + x0, z0 + y1 + x1,
-                               z1 + y0 + x0, z1 + y0 + x1, z1 + y1 + x0, z1 + y1 + x1 };
-  Vec4          p[8];
-  // A padded load reads past the pixel: not at the last pixel of the buffer.
-  if (corners[7] < sampler.lastPixel)
-  {
-    for (unsigned int k = 0; k < 8; ++k)
-    {
-      p[k] = PixelLoader<ForcePixelType, true>::Load(sampler.buffer[corners[k]]);
-    }
-  }
-  else
-  {
-    for (unsigned int k = 0; k < 8; ++k)
-    {
-      p[k] = PixelLoader<ForcePixelType, false>::Load(sampler.buffer[corners[k]]);
-    }
-  }
-  return Trilinear(p, c[0] - static_cast<double>(fx), c[1] - static_cast<double>(fy), c[2] - static_cast<double>(fz));
-}
-
-template <typename TMesh, typename TForceImage>
-EDM_ALWAYS_INLINE void
-DeformableMeshFilter<TMesh, TForceImage>::SampleForces(const ForceSampler & sampler,
-                                                       const double *       x,
-                                                       SizeValueType        begin,
-                                                       SizeValueType        end,
-                                                       double               scale,
-                                                       Vec4 *               forces)
-{
-  using namespace DeformableMeshFilterDetail;
-#if EDM_AVX2_SAMPLER
-  if (sampler.smallBuffer)
-  {
-    // Four vertices at a time: their coordinates as one register per axis,
-    // then continuous indices, inside test, weights and the byte offsets of
-    // the eight corners (clamped at the border) in the lanes of registers;
-    // the corners are then loaded and blended vertex by vertex.
-    const char *  bytes = reinterpret_cast<const char *>(sampler.buffer);
-    const __m128i lastBytes = _mm_set1_epi32(static_cast<int32_t>(sampler.lastPixel * sizeof(ForcePixelType)));
-    constexpr SizeValueType maximumCount = ChunkSize; // the runs of StepBlock()
-    alignas(32) int32_t     corners[8][maximumCount];
-    alignas(32) double      weights[3][maximumCount];
-    uint32_t                insideBits = 0;
-    uint32_t                paddedBits = 0;
-    itkAssertInDebugAndIgnoreInReleaseMacro(end - begin <= maximumCount);
-    double tail[12];
-    for (SizeValueType j = begin; j < end; j += 4)
-    {
-      // The last group of a run may be short: its coordinates are copied,
-      // the missing vertices repeating the last one.
-      const SizeValueType count = std::min<SizeValueType>(4, end - j);
-      const double *      xj = x + 3 * j;
-      if (count < 4)
-      {
-        for (SizeValueType k = 0; k < 12; ++k)
-        {
-          tail[k] = xj[std::min(k, 3 * count - 3 + k % 3)];
-        }
-        xj = tail;
-      }
-      const __m256d a = _mm256_loadu_pd(xj);     // x0 y0 z0 x1
-      const __m256d b = _mm256_loadu_pd(xj + 4); // y1 z1 x2 y2
-      const __m256d c = _mm256_loadu_pd(xj + 8); // z2 x3 y3 z3
-      const __m256d axis[3] = { _mm256_permute4x64_pd(_mm256_blend_pd(_mm256_blend_pd(a, c, 0x2), b, 0x4), 0x6C),
-                                _mm256_permute4x64_pd(_mm256_blend_pd(_mm256_blend_pd(a, b, 0x9), c, 0x4), 0xB1),
-                                _mm256_permute4x64_pd(_mm256_blend_pd(_mm256_blend_pd(a, b, 0x2), c, 0x9), 0xC6) };
-      int           inside = 0xF;
-      __m128i       low[3];
-      __m128i       high[3];
-      for (unsigned int k = 0; k < 3; ++k)
-      {
-        // The products and sums in the order GCC gives SampleForce() with FMA:
-        // both paths give the same bits there (checked on 300-step runs).
-        __m256d ck = _mm256_mul_pd(_mm256_set1_pd(sampler.columns[1][k]), axis[1]);
-        ck = _mm256_fmadd_pd(_mm256_set1_pd(sampler.columns[0][k]), axis[0], ck);
-        ck = _mm256_fmadd_pd(_mm256_set1_pd(sampler.columns[2][k]), axis[2], ck);
-        ck = _mm256_sub_pd(ck, _mm256_set1_pd(sampler.offset[k]));
-        inside &= _mm256_movemask_pd(_mm256_and_pd(_mm256_cmp_pd(ck, _mm256_set1_pd(sampler.lower[k]), _CMP_GE_OQ),
-                                                   _mm256_cmp_pd(ck, _mm256_set1_pd(sampler.upper[k]), _CMP_LT_OQ)));
-        const __m256d f = _mm256_floor_pd(ck);
-        const __m256d stride = _mm256_set1_pd(sampler.byteStrides[k]);
-        _mm256_store_pd(weights[k] + (j - begin), _mm256_sub_pd(ck, f));
-        low[k] = _mm256_cvttpd_epi32(_mm256_mul_pd(_mm256_max_pd(f, _mm256_setzero_pd()), stride));
-        high[k] = _mm256_cvttpd_epi32(
-          _mm256_mul_pd(_mm256_min_pd(_mm256_add_pd(f, _mm256_set1_pd(1.0)), _mm256_set1_pd(sampler.last[k])), stride));
-      }
-      const __m128i yz[4] = { _mm_add_epi32(low[1], low[2]),
-                              _mm_add_epi32(high[1], low[2]),
-                              _mm_add_epi32(low[1], high[2]),
-                              _mm_add_epi32(high[1], high[2]) };
-      for (unsigned int k = 0; k < 4; ++k)
-      {
-        _mm_store_si128(reinterpret_cast<__m128i *>(corners[2 * k] + (j - begin)), _mm_add_epi32(yz[k], low[0]));
-        _mm_store_si128(reinterpret_cast<__m128i *>(corners[2 * k + 1] + (j - begin)), _mm_add_epi32(yz[k], high[0]));
-      }
-      // A padded load reads past the pixel: not at the last pixel of the buffer.
-      const int padded = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(lastBytes, _mm_add_epi32(yz[3], high[0]))));
-      insideBits |= static_cast<uint32_t>(inside) << (j - begin);
-      paddedBits |= static_cast<uint32_t>(padded) << (j - begin);
-    }
-    // Then the loads and blends, which depend on nothing but the offsets
-    // above: the loads of several vertices are in flight at once.
-    for (SizeValueType l = 0; l < end - begin; ++l)
-    {
-      Vec4 force{};
-      if (insideBits & (uint32_t{ 1 } << l))
-      {
-        Vec4 p[8];
-        if (paddedBits & (uint32_t{ 1 } << l))
-        {
-          for (unsigned int k = 0; k < 8; ++k)
-          {
-            p[k] =
-              PixelLoader<ForcePixelType, true>::Load(*reinterpret_cast<const ForcePixelType *>(bytes + corners[k][l]));
-          }
-        }
-        else
-        {
-          for (unsigned int k = 0; k < 8; ++k)
-          {
-            p[k] = PixelLoader<ForcePixelType, false>::Load(
-              *reinterpret_cast<const ForcePixelType *>(bytes + corners[k][l]));
-          }
-        }
-        force = Splat(scale) * Trilinear(p, weights[0][l], weights[1][l], weights[2][l]);
-      }
-      forces[l] = force;
-    }
-    return;
-  }
-#endif
-  for (SizeValueType j = begin; j < end; ++j)
-  {
-    forces[j - begin] = Splat(scale) * SampleForce(sampler, Load4(x + 3 * j));
-  }
 }
 
 template <typename TMesh, typename TForceImage>
 void
 DeformableMeshFilter<TMesh, TForceImage>::BuildTopology()
 {
+  using namespace DeformableMeshFilterDetail;
   const MeshType *    input = this->GetInput();
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
   if (numberOfPoints >= std::numeric_limits<IndexType32>::max())
@@ -603,159 +437,6 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
 }
 
 template <typename TMesh, typename TForceImage>
-template <bool NeedNormal>
-inline void
-DeformableMeshFilter<TMesh, TForceImage>::ComputeGeometry(const double * x, SizeValueType i, Vec4 & u, Vec4 & n) const
-{
-  using namespace DeformableMeshFilterDetail;
-  const uint8_t kind = m_RingKinds[i];
-  if (kind == GeneralVertex)
-  {
-    // Through temporaries: u and n stay in registers on the other paths.
-    Vec4 generalU;
-    Vec4 generalN;
-    this->ComputeGeneralGeometry(x, i, generalU, generalN);
-    u = generalU;
-    n = generalN;
-    return;
-  }
-  const IndexType32   begin = m_NeighbourOffsets[i];
-  const IndexType32   end = m_NeighbourOffsets[i + 1];
-  const IndexType32 * ring = m_Neighbours.data();
-  if (begin == end)
-  {
-    u = Vec4{};
-    n = Vec4{};
-    return;
-  }
-  // Relative to x_i, so that the cross products do not lose digits to the
-  // distance from the origin. Lane 3 carries junk (the next coordinate in
-  // memory) until cleared.
-  const Vec4 xi = Load4(x + 3 * i);
-  // Straight-line code for the usual valences.
-  if (kind == ClosedRing && WithUsualValence(end - begin, [&](auto valence) {
-        ClosedRingGeometry<decltype(valence)::value, NeedNormal>(x, ring + begin, xi, u, n);
-      }))
-  {
-    return;
-  }
-  const Vec4 first = Load4(x + 3 * static_cast<SizeValueType>(ring[begin])) - xi;
-  const Vec4 firstRotated = Rotate(first);
-  Vec4       sum = first;
-  Vec4       twisted{}; // sum of d_j * R(d_j+1) - R(d_j) * d_j+1; R(twisted) is sum of d_j x d_j+1
-  Vec4       previous = first;
-  Vec4       previousRotated = firstRotated;
-#if defined(__GNUC__) && !defined(__clang__)
-#  pragma GCC unroll 2
-#endif
-  for (IndexType32 k = begin + 1; k < end; ++k)
-  {
-    const Vec4 d = Load4(x + 3 * static_cast<SizeValueType>(ring[k])) - xi;
-    sum += d;
-    if (NeedNormal)
-    {
-      const Vec4 rotated = Rotate(d);
-      twisted += previous * rotated - previousRotated * d;
-      previous = d;
-      previousRotated = rotated;
-    }
-  }
-  u = ClearLane3(sum * Splat(InverseCount(end - begin)));
-  if (NeedNormal)
-  {
-    if (kind == ClosedRing)
-    {
-      twisted += previous * firstRotated - previousRotated * first;
-    }
-    n = ClearLane3(Rotate(twisted));
-  }
-}
-
-template <typename TMesh, typename TForceImage>
-template <unsigned int K, bool NeedNormal>
-EDM_ALWAYS_INLINE void
-DeformableMeshFilter<TMesh, TForceImage>::ClosedRingGeometry(const double *      x,
-                                                             const IndexType32 * ring,
-                                                             const Vec4 &        xi,
-                                                             Vec4 &              u,
-                                                             Vec4 &              n)
-{
-  using namespace DeformableMeshFilterDetail;
-  // As ComputeGeometry(), with the sums split in two (even and odd terms) to
-  // shorten their dependency chains.
-  Vec4 d[K];
-  Vec4 r[K];
-#if defined(__GNUC__) && !defined(__clang__)
-#  pragma GCC unroll 8
-#endif
-  for (unsigned int k = 0; k < K; ++k)
-  {
-    d[k] = Load4(x + 3 * static_cast<SizeValueType>(ring[k])) - xi;
-    r[k] = Rotate(d[k]);
-  }
-  Vec4 sum[2] = { d[0], d[1] };
-#if defined(__GNUC__) && !defined(__clang__)
-#  pragma GCC unroll 8
-#endif
-  for (unsigned int k = 2; k < K; ++k)
-  {
-    sum[k % 2] += d[k];
-  }
-  u = ClearLane3((sum[0] + sum[1]) * Splat(1.0 / static_cast<double>(K)));
-  if (NeedNormal)
-  {
-    Vec4 twisted[2] = { d[0] * r[1] - r[0] * d[1], d[1] * r[2] - r[1] * d[2] };
-#if defined(__GNUC__) && !defined(__clang__)
-#  pragma GCC unroll 8
-#endif
-    for (unsigned int k = 2; k < K; ++k)
-    {
-      twisted[k % 2] += d[k] * r[(k + 1) % K] - r[k] * d[(k + 1) % K];
-    }
-    n = ClearLane3(Rotate(twisted[0] + twisted[1]));
-  }
-}
-
-template <typename TMesh, typename TForceImage>
-void
-DeformableMeshFilter<TMesh, TForceImage>::ComputeGeneralGeometry(const double * x,
-                                                                 SizeValueType  i,
-                                                                 Vec4 &         u,
-                                                                 Vec4 &         n) const
-{
-  using namespace DeformableMeshFilterDetail;
-  const double * xi = x + 3 * i;
-  double         s[3] = { 0.0, 0.0, 0.0 };
-  const auto     begin = m_NeighbourOffsets[i];
-  const auto     end = m_NeighbourOffsets[i + 1];
-  for (IndexType32 k = begin; k < end; ++k)
-  {
-    const double * y = x + 3 * static_cast<SizeValueType>(m_Neighbours[k]);
-    s[0] += y[0] - xi[0];
-    s[1] += y[1] - xi[1];
-    s[2] += y[2] - xi[2];
-  }
-  const double inverseCount = end > begin ? 1.0 / static_cast<double>(end - begin) : 0.0;
-  u = Vec4{ s[0] * inverseCount, s[1] * inverseCount, s[2] * inverseCount, 0.0 };
-
-  const auto rank = static_cast<SizeValueType>(
-    std::lower_bound(m_GeneralVertices.begin(), m_GeneralVertices.end(), static_cast<IndexType32>(i)) -
-    m_GeneralVertices.begin());
-  double normal[3] = { 0.0, 0.0, 0.0 };
-  for (IndexType32 k = m_GeneralPairOffsets[rank]; k < m_GeneralPairOffsets[rank + 1]; ++k)
-  {
-    const double * b = x + 3 * static_cast<SizeValueType>(m_GeneralPairs[2 * k]);
-    const double * c = x + 3 * static_cast<SizeValueType>(m_GeneralPairs[2 * k + 1]);
-    const double   e[3] = { b[0] - xi[0], b[1] - xi[1], b[2] - xi[2] };
-    const double   f[3] = { c[0] - xi[0], c[1] - xi[1], c[2] - xi[2] };
-    normal[0] += e[1] * f[2] - e[2] * f[1];
-    normal[1] += e[2] * f[0] - e[0] * f[2];
-    normal[2] += e[0] * f[1] - e[1] * f[0];
-  }
-  n = Vec4{ normal[0], normal[1], normal[2], 0.0 };
-}
-
-template <typename TMesh, typename TForceImage>
 void
 DeformableMeshFilter<TMesh, TForceImage>::Iterate()
 {
@@ -789,12 +470,11 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
                         (m_ConvergenceTolerance > 0.0 && m_QuietIterations + 1 >= m_ConvergenceWindow) ||
                         this->HasObserver(IterationEvent()) || this->HasObserver(ProgressEvent());
 
-  constexpr SizeValueType blockSize = 512;
-  static_assert(blockSize % ChunkSize == 0, "blocks are made of whole chunks");
   const bool          ordered = !m_ValenceOrder.empty();
-  const SizeValueType numberOfBlocks = (numberOfPoints + blockSize - 1) / blockSize;
+  const SizeValueType numberOfBlocks = (numberOfPoints + BlockSize - 1) / BlockSize;
   MultiThreaderBase * threader = this->GetMultiThreader();
   threader->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
+  const KernelPath path = GetKernelPath();
 
   // With rigidity, a first pass stores the umbrella vectors (and normals) of
   // all vertices: the rigidity force is the umbrella of the umbrella field.
@@ -811,45 +491,67 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
     {
       m_Normals.assign(4 * numberOfPoints, 0.0f);
     }
+  }
+  const MeshTables mesh{ m_NeighbourOffsets.data(),   m_Neighbours.data(),
+                         m_RingKinds.data(),          m_GeneralVertices.data(),
+                         m_GeneralVertices.size(),    m_GeneralPairOffsets.data(),
+                         m_GeneralPairs.data(),       ordered ? m_ValenceOrder.data() : nullptr };
+  StepArrays       arrays{ coordinates.data(),
+                     m_NextCoordinates.data(),
+                     m_Umbrella.data(),
+                     m_Normals.data(),
+                     m_BalloonReleased.data(),
+                     nullptr,
+                     m_DisplacementMagnitudes.data(),
+                     m_ExternalForceMagnitudes.data(),
+                     m_InternalForceMagnitudes.data() };
+  if (useRigidity)
+  {
+    const double orientationSign = m_OrientationSign;
     threader->ParallelizeArray(
       0,
       numberOfBlocks,
-      [this, numberOfPoints, useNormal, ordered](SizeValueType block) {
-        const SizeValueType begin = block * blockSize;
-        const SizeValueType end = std::min(numberOfPoints, begin + blockSize);
-        WithConstant(useNormal, [&](auto needNormal) {
-          WithConstant(ordered, [&](auto inOrder) {
-            this->GeometryBlock<decltype(needNormal)::value, decltype(inOrder)::value>(begin, end);
-          });
-        });
+      [&](SizeValueType block) {
+        const SizeValueType begin = block * BlockSize;
+        RunGeometryBlock(
+          path, useNormal, ordered, mesh, arrays, orientationSign, begin, std::min(numberOfPoints, begin + BlockSize));
       },
       nullptr);
   }
   if (useImageTerms)
   {
     this->UpdateNormalSpeeds();
+    arrays.normalSpeeds = m_NormalSpeeds.data();
   }
   else
   {
     m_NormalSpeeds.clear();
   }
 
+  // Stability of the explicit internal update requires a + 2b <= 1: larger
+  // sums are scaled.
+  const double    internalSum = m_Elasticity + 2.0 * m_Rigidity;
+  const double    internalScale = internalSum > 1.0 ? 1.0 / internalSum : 1.0;
+  const StepTerms terms{ m_ScaleFactor,      m_Elasticity * internalScale, m_Rigidity * internalScale,
+                         m_TangentialElasticity, m_Balloon,                   m_MaximumStepLength,
+                         m_OrientationSign };
   std::vector<double> blockMaximum(numberOfBlocks, 0.0);
   threader->ParallelizeArray(
     0,
     numberOfBlocks,
-    [this, numberOfPoints, useRigidity, useNormal, ordered, diagnose, &blockMaximum](SizeValueType block) {
-      const SizeValueType begin = block * blockSize;
-      const SizeValueType end = std::min(numberOfPoints, begin + blockSize);
-      WithConstant(useRigidity, [&](auto rigidity) {
-        WithConstant(useNormal, [&](auto normal) {
-          WithConstant(ordered, [&](auto inOrder) {
-            blockMaximum[block] =
-              this->StepBlock<decltype(rigidity)::value, decltype(normal)::value, decltype(inOrder)::value>(
-                begin, end, diagnose);
-          });
-        });
-      });
+    [&](SizeValueType block) {
+      const SizeValueType begin = block * BlockSize;
+      blockMaximum[block] = RunStepBlock(path,
+                                         useRigidity,
+                                         useNormal,
+                                         ordered,
+                                         m_Sampler,
+                                         mesh,
+                                         terms,
+                                         arrays,
+                                         begin,
+                                         std::min(numberOfPoints, begin + BlockSize),
+                                         diagnose);
     },
     nullptr);
 
@@ -864,209 +566,6 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   {
     m_QuietIterations = 0;
   }
-}
-
-template <typename TMesh, typename TForceImage>
-template <bool NeedNormal, bool Ordered>
-void
-DeformableMeshFilter<TMesh, TForceImage>::GeometryBlock(SizeValueType begin, SizeValueType end)
-{
-  using namespace DeformableMeshFilterDetail;
-  const double * x = this->GetCoordinates().data();
-  float *        umbrellaField = m_Umbrella.data();
-  float *        normalField = m_Normals.data();
-  const double   orientationSign = m_OrientationSign;
-  // The normals of a chunk of vertices are scaled to unit length after the
-  // chunk: the square roots and divisions then overlap across vertices
-  // instead of ending each vertex's chain of dependent operations.
-  constexpr SizeValueType chunk = ChunkSize;
-  Vec4                    normals[chunk];
-  const uint8_t *         order = m_ValenceOrder.data();
-  for (SizeValueType chunkBegin = begin; chunkBegin < end; chunkBegin += chunk)
-  {
-    const SizeValueType chunkEnd = std::min(end, chunkBegin + chunk);
-    for (SizeValueType k = chunkBegin; k < chunkEnd; ++k)
-    {
-      const SizeValueType i = Ordered ? chunkBegin + order[k] : k;
-      Vec4                u;
-      Vec4                n;
-      this->template ComputeGeometry<NeedNormal>(x, i, u, n);
-      StoreFloat4(umbrellaField + 4 * i, u);
-      if (NeedNormal)
-      {
-        normals[i - chunkBegin] = n;
-      }
-    }
-    if (NeedNormal)
-    {
-      for (SizeValueType i = chunkBegin; i < chunkEnd; ++i)
-      {
-        const double squaredLength = Dot3(normals[i - chunkBegin], normals[i - chunkBegin]);
-        StoreFloat4(normalField + 4 * i,
-                    squaredLength > 0.0 ? normals[i - chunkBegin] * Splat(orientationSign / std::sqrt(squaredLength))
-                                        : Vec4{});
-      }
-    }
-  }
-}
-
-template <typename TMesh, typename TForceImage>
-template <bool UseRigidity, bool UseNormal, bool Ordered>
-double
-DeformableMeshFilter<TMesh, TForceImage>::StepBlock(SizeValueType begin, SizeValueType end, bool diagnose)
-{
-  using namespace DeformableMeshFilterDetail;
-  // Everything the loop reads, in locals: the compiler cannot keep members in
-  // registers across the stores to the output arrays. Stability of the
-  // explicit internal update requires a + 2b <= 1: larger sums are scaled.
-  const double        internalSum = m_Elasticity + 2.0 * m_Rigidity;
-  const double        internalScale = internalSum > 1.0 ? 1.0 / internalSum : 1.0;
-  const double        elasticity = m_Elasticity * internalScale;
-  const double        rigidity = m_Rigidity * internalScale;
-  const bool          useElasticity = elasticity > 0.0;
-  const bool          tangential = useElasticity && m_TangentialElasticity;
-  const double        scaleFactor = m_ScaleFactor;
-  const double        balloon = m_Balloon;
-  const double        maximumStep = m_MaximumStepLength;
-  const double        orientationSign = m_OrientationSign;
-  const uint8_t *     order = m_ValenceOrder.data();
-  const ForceSampler  sampler = m_Sampler;
-  const double *      x = this->GetCoordinates().data();
-  double *            next = m_NextCoordinates.data();
-  const float *       umbrellaField = m_Umbrella.data();
-  const float *       normalField = m_Normals.data();
-  const IndexType32 * offsets = m_NeighbourOffsets.data();
-  const IndexType32 * neighbours = m_Neighbours.data();
-  uint8_t *           balloonReleased = m_BalloonReleased.data();
-  const float *       normalSpeeds = m_NormalSpeeds.empty() ? nullptr : m_NormalSpeeds.data();
-  float *             displacementMagnitudes = m_DisplacementMagnitudes.data();
-  float *             externalMagnitudes = m_ExternalForceMagnitudes.data();
-  float *             internalMagnitudes = m_InternalForceMagnitudes.data();
-
-  // The external forces of a run of vertices first, then the rest: two short
-  // loop bodies whose long dependency chains (index, voxel loads,
-  // interpolation; neighbour loads, normal) overlap across vertices.
-  constexpr SizeValueType run = ChunkSize;
-  Vec4                    externalForces[run];
-  double                  squaredSteps[run];
-  double                  largest = 0.0; // squared
-  for (SizeValueType runBegin = begin; runBegin < end; runBegin += run)
-  {
-    const SizeValueType runEnd = std::min(end, runBegin + run);
-    SampleForces(sampler, x, runBegin, runEnd, scaleFactor, externalForces);
-    for (SizeValueType k = runBegin; k < runEnd; ++k)
-    {
-      const SizeValueType i = Ordered ? runBegin + order[k] : k;
-      const Vec4          xi = Load4(x + 3 * i);
-      Vec4                u{};
-      Vec4                n{};
-      Vec4                internal{};
-      if (UseRigidity)
-      {
-        u = LoadFloat4(umbrellaField + 4 * i);
-        if (UseNormal)
-        {
-          n = LoadFloat4(normalField + 4 * i);
-        }
-        const IndexType32 first = offsets[i];
-        const IndexType32 stop = offsets[i + 1];
-        if (stop > first)
-        {
-          Vec4 sum{};
-          if (!WithUsualValence(stop - first, [&](auto valence) {
-                sum = GatherSum<decltype(valence)::value>(umbrellaField, neighbours + first);
-              }))
-          {
-            for (IndexType32 k = first; k < stop; ++k)
-            {
-              sum += LoadFloat4(umbrellaField + 4 * static_cast<SizeValueType>(neighbours[k]));
-            }
-          }
-          internal = Splat(rigidity) * (u - sum * Splat(InverseCount(stop - first)));
-        }
-      }
-      else if (UseNormal)
-      {
-        this->template ComputeGeometry<true>(x, i, u, n);
-        n = UnitVector(n, orientationSign);
-      }
-      else if (useElasticity)
-      {
-        this->template ComputeGeometry<false>(x, i, u, n);
-      }
-      if (useElasticity)
-      {
-        const Vec4 e = tangential ? u - Dot4Splat(u, n) * n : u;
-        internal += Splat(elasticity) * e;
-      }
-
-      const Vec4 external = externalForces[i - runBegin];
-      // The balloon carries a vertex to an edge, not past it: once the external
-      // force opposes it with half its strength, the vertex is in the edge's
-      // capture range and the balloon is released for it, so that it settles on
-      // the edge itself instead of where the forces balance.
-      double inflation = 0.0;
-      if (UseNormal && balloon != 0.0 && !balloonReleased[i])
-      {
-        if (balloon * Dot3(external, n) <= -0.5 * balloon * balloon)
-        {
-          balloonReleased[i] = 1;
-        }
-        else
-        {
-          inflation = balloon;
-        }
-      }
-      if (UseNormal && normalSpeeds != nullptr)
-      {
-        inflation += normalSpeeds[i];
-      }
-      Vec4 delta = external + internal;
-      if (UseNormal)
-      {
-        delta += Splat(inflation) * n;
-      }
-      if (maximumStep > 0.0)
-      {
-        const double length = std::sqrt(Dot3(delta, delta));
-        if (length > maximumStep)
-        {
-          delta *= Splat(maximumStep / length);
-        }
-      }
-      // A 4-wide store spills into the next point's first coordinate, which the
-      // next iteration of this loop overwrites; not at the block's end, nor
-      // when the vertices are not processed in order.
-      if (!Ordered && i + 1 < end)
-      {
-        Store4(next + 3 * i, xi + delta);
-      }
-      else
-      {
-        Store3(next + 3 * i, xi + delta);
-      }
-
-      // Diagnostics, in single precision as they are stored: the three lengths
-      // with one square root. The largest displacement is kept squared.
-      if (diagnose)
-      {
-        const Vec4 squares = SquaredLengths(delta, external, internal);
-        SqrtStore3(squares, displacementMagnitudes + i, externalMagnitudes + i, internalMagnitudes + i);
-        squaredSteps[i - runBegin] = squares[0];
-      }
-      else
-      {
-        squaredSteps[i - runBegin] = Dot3(delta, delta);
-      }
-    }
-    // Apart from the loop above: a running maximum there is a dependency
-    // chain through memory when the registers run short.
-    for (SizeValueType k = 0; k < runEnd - runBegin; ++k)
-    {
-      largest = std::max(largest, squaredSteps[k]);
-    }
-  }
-  return std::sqrt(largest);
 }
 
 template <typename TMesh, typename TForceImage>
