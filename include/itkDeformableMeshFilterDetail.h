@@ -161,18 +161,24 @@ KernelPathAvailable(KernelPath path)
   return false;
 }
 
-/** The fastest available path, or the one the environment variable
- * EDM_KERNEL_PATH names (avx2, sse2, portable) when it is available. */
+/** The path the environment variable EDM_KERNEL_PATH names (avx2, sse2,
+ * portable) when it is available, else the fastest available one. */
 inline KernelPath
 DefaultKernelPath()
 {
-  const char * requested = std::getenv("EDM_KERNEL_PATH");
-  for (const KernelPath path : { KernelPath::AVX2FMA, KernelPath::SSE2, KernelPath::Portable })
+  const KernelPath paths[] = { KernelPath::AVX2FMA, KernelPath::SSE2, KernelPath::Portable };
+  if (const char * requested = std::getenv("EDM_KERNEL_PATH"))
   {
-    if (requested != nullptr && *requested != '\0' && std::strcmp(requested, KernelPathName(path)) != 0)
+    for (const KernelPath path : paths)
     {
-      continue;
+      if (std::strcmp(requested, KernelPathName(path)) == 0 && KernelPathAvailable(path))
+      {
+        return path;
+      }
     }
+  }
+  for (const KernelPath path : paths)
+  {
     if (KernelPathAvailable(path))
     {
       return path;
