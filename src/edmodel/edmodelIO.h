@@ -9,6 +9,7 @@
 #include "itkMesh.h"
 
 #include <string>
+#include <vector>
 
 namespace edm
 {
@@ -20,14 +21,24 @@ using ForceImageType = itk::Image<itk::CovariantVector<float, 3>, 3>;
 using MeshType = itk::Mesh<double, 3, itk::DefaultStaticMeshTraits<double, 3, 3, double, double>>;
 
 /** Reads a 3-D image (a file ITK reads, or a directory holding a DICOM
- * series) as float. Throws Error (exit code 2) naming the problem: missing or
- * unreadable file, unknown format, a 2-D or 4-D image. */
+ * series) as float. Throws Error (exit code 2) naming the problem, before
+ * allocating the voxels where it can: missing, unreadable or not a regular
+ * file (a FIFO), unknown format, a 2-D or 4-D image, spacing or origin out of
+ * range, data shorter than the header announces (truncated MetaImage, NIfTI,
+ * NRRD, DICOM slices; compressed data inflated to check), more memory needed
+ * than available (with \a gradientVectorFlow, the diffusion's arrays too),
+ * NaN or infinite voxels, double values beyond the float range. The
+ * libraries' own messages are folded into the Error's line. */
 ImageType::Pointer
-ReadImage(const std::string & path);
+ReadImage(const std::string & path, bool gradientVectorFlow = false);
 
 /** Reads a surface mesh (.vtk, .obj, .off, .gii; .vtp and .stl with VTK). \a option names the
  * command-line option in messages. Throws Error when the file is missing,
- * unreadable, of an unknown format or has no triangle or polygon. */
+ * unreadable, of an unknown format or has no triangle or polygon. Legacy .vtk,
+ * .off and .obj are parsed here, not by ITK 5.2's readers (which loop forever
+ * on some malformed files): every count is checked against the file's size
+ * before anything is allocated, every token as it is read (non-finite
+ * coordinates, indices out of range); OBJ's negative indices count back. */
 MeshType::Pointer
 ReadMesh(const std::string & path, const std::string & option);
 
@@ -46,9 +57,32 @@ WritePolyDataMesh(const MeshType * mesh, const std::string & path);
 void
 CheckMeshOutputPath(const std::string & path, const std::string & option);
 
-/** Same for an image. */
+/** Same for an image: .nii.gz, .nii, .nrrd, .nhdr, .mha or .mhd. */
 void
 CheckImageOutputPath(const std::string & path, const std::string & option);
+
+/** Throws Error when \a output names the same file as one of \a inputs. */
+void
+CheckNotAnInput(const std::string & output, const std::string & option, const std::vector<std::string> & inputs);
+
+/** Blocks SIGINT, SIGTERM, SIGHUP, SIGQUIT and SIGPIPE in every thread
+ * (call it first in main, before any thread starts) and starts the thread
+ * that takes them: it removes the temporary outputs in progress, waits for a
+ * Commit() under way, then lets the signal end the process. */
+void
+InstallSignalCleanup();
+
+/** A directory the signal thread removes (recursively, or only when empty)
+ * if a signal ends the run; the id unregisters it. */
+int
+RegisterTemporaryDirectory(const std::string & path, bool recursive);
+void
+UnregisterTemporaryDirectory(int id);
+
+/** Writes \a data to \a path, checking every write and the close (a full
+ * disk is an Error). */
+void
+WriteFileContents(const std::string & data, const std::string & path);
 
 /** Writers: the file appears complete, or not at all. Throw Error (exit
  * code 2) when writing fails. */
@@ -60,11 +94,14 @@ void
 WriteImage(const ForceImageType * image, const std::string & path);
 
 /** A file written through a temporary directory beside it,
- * DIR/.edmodel-PID-NAME/NAME (same file system, same file name so that
- * writers pick the same format and multi-file formats such as .mhd + .raw or
- * a .pvd series keep consistent names). Commit() renames every file of the
- * temporary directory into DIR; otherwise the destructor (or SIGINT, SIGTERM)
- * removes them: a failed run leaves no partial output. */
+ * DIR/.edmodel-PID-K/NAME (same file system; a short directory name whatever
+ * NAME's length; NAME with its extension in lower case so that writers pick
+ * the format, and multi-file formats such as .mhd + .raw or a .pvd series
+ * keep consistent names). Commit() checks that the files reached the disk and
+ * that the file system did not fill up (some writers do not check their
+ * writes), then renames them into DIR (NAME to the path given); otherwise the
+ * destructor (or a signal, see InstallSignalCleanup) removes them: a failed
+ * run leaves no partial output. */
 class AtomicOutput
 {
 public:

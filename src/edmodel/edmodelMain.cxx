@@ -3,12 +3,14 @@
 // This file parses the command line and prints the help; the ITK pipeline is
 // in edmodelPipeline.cxx, image and mesh files in edmodelIO.cxx.
 
+#include "edmodelIO.h"
 #include "edmodelOptions.h"
 
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <functional>
 #include <iostream>
 #include <sstream>
@@ -52,9 +54,13 @@ ParseUnsigned(const std::string & option, const std::string & text)
   char *       end = nullptr;
   errno = 0;
   const long long value = std::strtoll(begin, &end, 10);
-  if (text.empty() || end == begin || *end != '\0' || errno == ERANGE || value < 0 || value > 1000000000LL)
+  if (text.empty() || end == begin || *end != '\0' || (errno == ERANGE && value < 0) || value < 0)
   {
     throw Error(option + ": '" + text + "' is not a non-negative integer");
+  }
+  if (errno == ERANGE || value > 1000000000LL)
+  {
+    throw Error(option + ": " + text + " is too large (at most 1000000000)");
   }
   return static_cast<unsigned int>(value);
 }
@@ -615,6 +621,19 @@ Main(const std::vector<std::string> & args)
     {
       throw Error("segment: --every needs --snapshots DIR");
     }
+    // An output that is an input would replace it.
+    const std::vector<std::string> inputs{ options.image, options.initMesh };
+    CheckNotAnInput(options.output, "--output", inputs);
+    if (!options.forceOutput.empty())
+    {
+      CheckNotAnInput(options.forceOutput, "--force-output", inputs);
+      std::error_code error;
+      if (std::filesystem::weakly_canonical(options.forceOutput, error) ==
+          std::filesystem::weakly_canonical(options.output, error))
+      {
+        throw Error("--force-output: '" + options.forceOutput + "' is also the --output mesh");
+      }
+    }
     SetNumberOfThreads(global.threads);
     return RunSegment(options, global);
   }
@@ -639,6 +658,8 @@ Main(const std::vector<std::string> & args)
 int
 main(int argc, char * argv[])
 {
+  // First, before any thread starts: signals remove the temporary outputs.
+  edm::InstallSignalCleanup();
   const std::vector<std::string> args(argv, argv + argc);
   try
   {
@@ -648,6 +669,11 @@ main(int argc, char * argv[])
   {
     std::cerr << "edmodel: " << error.what() << std::endl;
     return error.GetExitCode();
+  }
+  catch (const std::bad_alloc &)
+  {
+    std::cerr << "edmodel: out of memory (the input is too large for this machine or its memory limit)" << std::endl;
+    return edm::ExitUsage;
   }
   catch (const std::exception & error)
   {

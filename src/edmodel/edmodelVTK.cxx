@@ -13,6 +13,8 @@
 #include "vtkXMLPolyDataReader.h"
 #include "vtkXMLPolyDataWriter.h"
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <memory>
 
@@ -74,12 +76,18 @@ WritePolyDataMesh(const MeshType * mesh, const std::string & path)
   }
   else
   {
+    // To memory, then to the file with every write checked: VTK's XML writer
+    // crashes on a full disk.
     vtkNew<vtkXMLPolyDataWriter> writer;
     writer->SetInputData(polyData);
-    writer->SetFileName(path.c_str());
+    writer->WriteToOutputStringOn();
     writer->SetDataModeToBinary(); // inline: ParaView 5.11 on Debian 12 cannot parse appended data
     writer->SetCompressorTypeToZLib();
     written = writer->Write();
+    if (written == 1)
+    {
+      WriteFileContents(writer->GetOutputString(), path);
+    }
   }
   if (written != 1)
   {
@@ -90,8 +98,10 @@ WritePolyDataMesh(const MeshType * mesh, const std::string & path)
 struct SnapshotSeries::Internals
 {
   std::string                               directory;
+  std::string                               name;
   std::string                               collection;
   bool                                      createdDirectory{ false };
+  int                                       cleanup{ -1 };
   std::unique_ptr<AtomicOutput>             output;
   vtkSmartPointer<vtkIterationSeriesWriter> writer;
 };
@@ -117,8 +127,12 @@ SnapshotSeries::SnapshotSeries(const std::string & directory, const std::string 
       throw Error("--snapshots: cannot create directory '" + directory + "': " + error.message());
     }
     m_Internals->createdDirectory = true;
+    // Removed if a signal ends the run (only when empty: after the series'
+    // temporary directory).
+    m_Internals->cleanup = RegisterTemporaryDirectory(directory, false);
   }
   m_Internals->directory = directory;
+  m_Internals->name = name;
   m_Internals->collection = (fs::path(directory) / (name + ".pvd")).string();
   m_Internals->output = std::make_unique<AtomicOutput>(m_Internals->collection);
   m_Internals->writer = vtkSmartPointer<vtkIterationSeriesWriter>::New();
@@ -129,6 +143,7 @@ SnapshotSeries::~SnapshotSeries()
 {
   const bool createdDirectory = m_Internals->createdDirectory;
   const auto directory = m_Internals->directory;
+  UnregisterTemporaryDirectory(m_Internals->cleanup);
   delete m_Internals;
   if (createdDirectory)
   {
@@ -148,7 +163,7 @@ SnapshotSeries::Add(const MeshType * mesh, itk::SizeValueType iteration)
   if (m_Internals->writer->WriteIteration(polyData, static_cast<int>(iteration)) != 1)
   {
     throw Error("--snapshots: cannot write the mesh of iteration " + std::to_string(iteration) + " in '" +
-                m_Internals->directory + "'");
+                m_Internals->directory + "' (is the disk full?)");
   }
 }
 
@@ -157,7 +172,26 @@ SnapshotSeries::Commit()
 {
   if (m_Internals->writer->WriteCollection() != 1)
   {
-    throw Error("--snapshots: cannot write '" + m_Internals->collection + "'");
+    throw Error("--snapshots: cannot write '" + m_Internals->collection + "' (is the disk full?)");
+  }
+  // The files of an earlier series of this name that the new one does not
+  // replace would mix with it: removed first.
+  std::error_code   error;
+  const fs::path    temporary = fs::path(m_Internals->output->GetTemporaryPath()).parent_path();
+  const std::string prefix = m_Internals->name + "_";
+  for (const auto & entry : fs::directory_iterator(m_Internals->directory, error))
+  {
+    const std::string file = entry.path().filename().string();
+    const bool        numbered = file.size() > prefix.size() + 4 && file.compare(0, prefix.size(), prefix) == 0 &&
+                          file.compare(file.size() - 4, 4, ".vtp") == 0 &&
+                          std::all_of(file.begin() + static_cast<std::ptrdiff_t>(prefix.size()),
+                                      file.end() - 4,
+                                      [](unsigned char c) { return std::isdigit(c) != 0; });
+    if (numbered && !fs::exists(temporary / file))
+    {
+      std::error_code ignored;
+      fs::remove(entry.path(), ignored);
+    }
   }
   m_Internals->output->Commit();
   m_Internals->createdDirectory = false;

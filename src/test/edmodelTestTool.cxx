@@ -4,7 +4,7 @@
 //
 //   edmodelTestTool phantom IMG --size X,Y,Z --spacing X,Y,Z --origin X,Y,Z
 //                   [--direction 9 numbers, row by row] --center X,Y,Z --radii A,B,C
-//                   [--axes 9 numbers] [--inside V] [--outside V] [--pixel float|short]
+//                   [--axes 9 numbers] [--inside V] [--outside V] [--pixel float|short|double]
 //   edmodelTestTool dicom DIR (same options as phantom, 16-bit slices)
 //   edmodelTestTool sphere MESH --center X,Y,Z --radius R [--resolution N]
 //   edmodelTestTool lines MESH          (points and lines: no triangle)
@@ -291,6 +291,10 @@ main(int argc, char * argv[])
       if (pixel == "short")
       {
         WritePhantom<short>(path, options);
+      }
+      else if (pixel == "double")
+      {
+        WritePhantom<double>(path, options);
       }
       else
       {

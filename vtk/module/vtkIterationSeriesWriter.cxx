@@ -24,7 +24,9 @@
 #include "vtkXMLPolyDataWriter.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <string>
 #include <utility>
@@ -54,6 +56,35 @@ SplitFileName(const std::string & fileName, std::string & directory, std::string
   {
     stem = stem.substr(0, dot);
   }
+}
+
+/** Writes \a data to \a path, every call checked; a partial file is removed. */
+bool
+WriteChecked(const std::string & data, const std::string & path, std::string & problem)
+{
+  std::FILE * file = std::fopen(path.c_str(), "wb");
+  if (file == nullptr)
+  {
+    problem = std::strerror(errno);
+    return false;
+  }
+  const std::size_t written = std::fwrite(data.data(), 1, data.size(), file);
+  int               code = written == data.size() ? 0 : errno;
+  if (std::fflush(file) != 0 && code == 0)
+  {
+    code = errno;
+  }
+  if (std::fclose(file) != 0 && code == 0)
+  {
+    code = errno;
+  }
+  if (code != 0 || written != data.size())
+  {
+    problem = std::strerror(code != 0 ? code : EIO);
+    std::remove(path.c_str());
+    return false;
+  }
+  return true;
 }
 
 std::string
@@ -154,8 +185,10 @@ vtkIterationSeriesWriter::WriteIteration(vtkPolyData * mesh, int iteration)
   std::snprintf(number, sizeof(number), "_%06d.vtp", iteration);
   const std::string path = directory + stem + number;
 
+  // To memory, then to the file with every write checked: VTK's XML writer
+  // crashes when the disk fills up under it.
   auto writer = vtkSmartPointer<vtkXMLPolyDataWriter>::New();
-  writer->SetFileName(path.c_str());
+  writer->WriteToOutputStringOn();
   writer->SetInputData(mesh);
   if (this->Binary)
   {
@@ -168,6 +201,12 @@ vtkIterationSeriesWriter::WriteIteration(vtkPolyData * mesh, int iteration)
   if (writer->Write() != 1 || writer->GetErrorCode() != vtkErrorCode::NoError)
   {
     vtkErrorMacro("Cannot write " << path << ".");
+    return 0;
+  }
+  std::string problem;
+  if (!WriteChecked(writer->GetOutputString(), path, problem))
+  {
+    vtkErrorMacro("Cannot write " << path << ": " << problem << ".");
     return 0;
   }
   this->Internals->Files.emplace_back(iteration, path);
