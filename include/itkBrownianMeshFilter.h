@@ -57,7 +57,7 @@ public:
   itkNewMacro(Self);
 
   /** Run-time type information (and related methods). */
-  itkTypeMacro(BrownianMeshFilter, IterativeMeshFilter);
+  itkOverrideGetNameOfClassMacro(BrownianMeshFilter);
 
   using MeshType = TMesh;
   static constexpr unsigned int PointDimension = Superclass::PointDimension;
@@ -81,7 +81,7 @@ protected:
   PrintSelf(std::ostream & os, Indent indent) const override;
 
   void
-  VerifyPreconditions() ITKv5_CONST override;
+  VerifyPreconditions() const override;
 
   void
   Iterate() override;

@@ -48,7 +48,7 @@ ToUnitInterval(uint64_t z)
 
 template <typename TMesh>
 void
-BrownianMeshFilter<TMesh>::VerifyPreconditions() ITKv5_CONST
+BrownianMeshFilter<TMesh>::VerifyPreconditions() const
 {
   Superclass::VerifyPreconditions();
   if (!std::isfinite(m_StepLength) || m_StepLength < 0.0)

@@ -108,7 +108,7 @@ public:
   itkNewMacro(Self);
 
   /** Run-time type information (and related methods). */
-  itkTypeMacro(DeformableMeshFilter, IterativeMeshFilter);
+  itkOverrideGetNameOfClassMacro(DeformableMeshFilter);
 
   using MeshType = TMesh;
   using ForceImageType = TForceImage;
@@ -231,7 +231,7 @@ protected:
   PrintSelf(std::ostream & os, Indent indent) const override;
 
   void
-  VerifyPreconditions() ITKv5_CONST override;
+  VerifyPreconditions() const override;
 
   void
   GenerateData() override;

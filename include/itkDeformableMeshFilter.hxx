@@ -40,7 +40,7 @@ DeformableMeshFilter<TMesh, TForceImage>::DeformableMeshFilter()
 
 template <typename TMesh, typename TForceImage>
 void
-DeformableMeshFilter<TMesh, TForceImage>::VerifyPreconditions() ITKv5_CONST
+DeformableMeshFilter<TMesh, TForceImage>::VerifyPreconditions() const
 {
   Superclass::VerifyPreconditions();
   if (this->GetForceImage() == nullptr)

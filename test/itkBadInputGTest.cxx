@@ -157,7 +157,7 @@ public:
   using Superclass = itk::IterativeMeshFilter<MeshType>;
   using Pointer = itk::SmartPointer<Self>;
   itkNewMacro(Self);
-  itkTypeMacro(DivergingMeshFilter, IterativeMeshFilter);
+  itkOverrideGetNameOfClassMacro(DivergingMeshFilter);
 
   itk::SizeValueType FailAt{ 3 };
   itk::SizeValueType Steps{ 0 };

@@ -45,7 +45,7 @@ public:
   using Superclass = itk::IterativeMeshFilter<MeshType>;
   using Pointer = itk::SmartPointer<Self>;
   itkNewMacro(Self);
-  itkTypeMacro(TranslationFilter, IterativeMeshFilter);
+  itkOverrideGetNameOfClassMacro(TranslationFilter);
 
   unsigned int m_Steps{ 0 };
   unsigned int m_Resets{ 0 };

@@ -18,6 +18,7 @@
 #ifndef edmPolyLineCell_h
 #define edmPolyLineCell_h
 
+#include "itkExplicitDeformableModelCompatibility.h"
 #include "itkPolygonCell.h"
 #include "itkVertexCell.h"
 
@@ -58,7 +59,7 @@ public:
   using VertexAutoPointer = typename VertexType::SelfAutoPointer;
 
   /** Standard part of every itk Object. */
-  itkTypeMacro(PolyLineCell, PolygonCell);
+  itkOverrideGetNameOfClassMacro(PolyLineCell);
 
   PolyLineCell() = default;
   ~PolyLineCell() override = default;
