@@ -569,6 +569,123 @@ InflatesTo(const std::string & path, std::uintmax_t offset, std::uintmax_t neede
 }
 #endif
 
+/** NIfTI's library replaces NaN and infinite voxels by 0 as it reads them:
+ * the float voxels of a .nii or .nii.gz are checked here first. */
+void
+CheckNiftiFloats(const std::string & path, const itk::ImageIOBase * io)
+{
+  const bool compressed = GetExtension(path) == ".nii.gz";
+  if (compressed)
+  {
+#ifndef EDM_HAVE_ZLIB
+    return;
+#endif
+  }
+  unsigned char header[348] = {};
+  std::string   bytes;
+#ifdef EDM_HAVE_ZLIB
+  gzFile file = compressed ? gzopen(path.c_str(), "rb") : nullptr;
+  if (compressed && (file == nullptr || gzread(file, header, sizeof(header)) != static_cast<int>(sizeof(header))))
+  {
+    if (file != nullptr)
+    {
+      gzclose(file);
+    }
+    return;
+  }
+#endif
+  std::ifstream stream;
+  if (!compressed)
+  {
+    stream.open(path, std::ios::binary);
+    stream.read(reinterpret_cast<char *>(header), sizeof(header));
+  }
+  std::int32_t sizeOfHeader = 0;
+  std::memcpy(&sizeOfHeader, header, 4);
+  const bool swapped = sizeOfHeader != 348;
+  auto       swap = [swapped](unsigned char * p, size_t n) {
+    if (swapped)
+    {
+      std::reverse(p, p + n);
+    }
+  };
+  swap(header + 70, 2);
+  swap(header + 108, 4);
+  std::int16_t datatype = 0;
+  float        voxelOffset = 0.0f;
+  std::memcpy(&datatype, header + 70, 2);
+  std::memcpy(&voxelOffset, header + 108, 4);
+  const size_t               size = datatype == 16 ? 4 : datatype == 64 ? 8 : 0;
+  const bool                 valid = (sizeOfHeader == 348 || swapped) && size != 0 && voxelOffset >= 348.0f;
+  std::uintmax_t             position = sizeof(header);
+  const auto                 skip = static_cast<std::uintmax_t>(valid ? voxelOffset : 0.0f);
+  const std::uintmax_t       count = io->GetImageSizeInBytes() / std::max<size_t>(size, 1);
+  std::vector<unsigned char> buffer(size * 65536);
+  std::uintmax_t             voxel = 0;
+  auto                       read = [&](unsigned char * into, size_t n) -> size_t {
+#ifdef EDM_HAVE_ZLIB
+    if (compressed)
+    {
+      const int got = gzread(file, into, static_cast<unsigned int>(n));
+      return got > 0 ? static_cast<size_t>(got) : 0;
+    }
+#endif
+    stream.read(reinterpret_cast<char *>(into), static_cast<std::streamsize>(n));
+    return static_cast<size_t>(stream.gcount());
+  };
+  std::string problem;
+  if (valid)
+  {
+    // To the first voxel.
+    std::vector<unsigned char> gap(skip > position ? skip - position : 0);
+    position += read(gap.data(), gap.size());
+    while (voxel < count && problem.empty())
+    {
+      const size_t want = static_cast<size_t>(std::min<std::uintmax_t>(count - voxel, 65536)) * size;
+      const size_t got = read(buffer.data(), want) / size;
+      if (got == 0)
+      {
+        break;
+      }
+      for (size_t i = 0; i < got; ++i, ++voxel)
+      {
+        unsigned char * p = buffer.data() + i * size;
+        swap(p, size);
+        double value = 0.0;
+        if (size == 4)
+        {
+          float f;
+          std::memcpy(&f, p, 4);
+          value = f;
+        }
+        else
+        {
+          std::memcpy(&value, p, 8);
+        }
+        if (!std::isfinite(value))
+        {
+          const std::uintmax_t nx = io->GetDimensions(0);
+          const std::uintmax_t ny = io->GetDimensions(1);
+          problem = "image " + Quote(path) + " has a non-finite value (" + FormatNumber(value) + ") at voxel (" +
+                    std::to_string(voxel % nx) + ", " + std::to_string(voxel / nx % ny) + ", " +
+                    std::to_string(voxel / nx / ny) + ")";
+          break;
+        }
+      }
+    }
+  }
+#ifdef EDM_HAVE_ZLIB
+  if (compressed)
+  {
+    gzclose(file);
+  }
+#endif
+  if (!problem.empty())
+  {
+    throw Error(problem);
+  }
+}
+
 /** Refuses an image file whose data is shorter than its header announces:
  * ITK's readers fill the missing voxels with zeros or stop silently. Checks
  * MetaImage, NIfTI and NRRD (raw and gzip data); other formats pass. */
@@ -681,6 +798,7 @@ CheckImageData(const std::string & path, const itk::ImageIOBase * io)
       {
         throw Error("cannot read image " + Quote(path) + ": " + problem);
       }
+      CheckNiftiFloats(path, io);
 #endif
       return;
     }
@@ -703,6 +821,10 @@ CheckImageData(const std::string & path, const itk::ImageIOBase * io)
     else
     {
       atEnd = true;
+    }
+    if (FileSize(path) >= offset + needed)
+    {
+      CheckNiftiFloats(path, io);
     }
   }
   else
@@ -836,6 +958,37 @@ ReadDoubleImage(const std::string & path, itk::ImageIOBase * io)
   return image;
 }
 
+/** Whether the last Pixel Data element (7FE0,0010) of a DICOM file holds
+ * the bytes its length announces (encapsulated, compressed data is not
+ * checked); \a held is what the file holds of it. */
+bool
+PixelDataComplete(const std::string & file, std::uintmax_t & held)
+{
+  const std::string data = ReadWholeFile(file, "DICOM file");
+  const char        tag[4] = { '\xE0', '\x7F', '\x10', '\x00' };
+  const auto        position = data.rfind(std::string(tag, 4));
+  if (position == std::string::npos)
+  {
+    return true;
+  }
+  // Explicit VR (OB, OW: 2 reserved bytes, 4-byte length) or implicit VR.
+  const bool explicitVR = position + 8 <= data.size() &&
+                          (data.compare(position + 4, 2, "OW") == 0 || data.compare(position + 4, 2, "OB") == 0);
+  const size_t  lengthAt = position + (explicitVR ? 8 : 4);
+  std::uint32_t length = 0;
+  if (lengthAt + 4 > data.size())
+  {
+    return false;
+  }
+  std::memcpy(&length, data.data() + lengthAt, 4);
+  if (length == 0xFFFFFFFFu)
+  {
+    return true;
+  }
+  held = data.size() - (lengthAt + 4);
+  return held >= length;
+}
+
 ImageType::Pointer
 ReadDicomSeries(const std::string & directory)
 {
@@ -883,11 +1036,12 @@ ReadDicomSeries(const std::string & directory)
       throw Error("cannot read DICOM file " + Quote(file) + ": " + Describe(exception, captured.Text()));
     }
     const std::uintmax_t needed = io->GetImageSizeInBytes();
-    if (FileSize(file) < needed)
+    std::uintmax_t       held = 0;
+    if (FileSize(file) < needed || !PixelDataComplete(file, held))
     {
-      throw Error("cannot read DICOM series in " + Quote(directory) + ": " + Quote(file) + " is truncated (" +
-                  std::to_string(FileSize(file)) + " bytes, less than its " + std::to_string(needed) +
-                  " bytes of pixel data)");
+      throw Error("cannot read DICOM series in " + Quote(directory) + ": " + Quote(file) +
+                  " is truncated (its pixel data element holds " + std::to_string(held) + " bytes of " +
+                  std::to_string(std::max<std::uintmax_t>(needed, held)) + ")");
     }
   }
   using ReaderType = itk::ImageSeriesReader<ImageType>;

@@ -163,6 +163,21 @@ inf-image)
   phantom image.nrrd --outside inf
   segment --image image.nrrd --output out.vtk
   refused "image '[^']*image.nrrd' has a non-finite value \(inf\)" out.vtk ;;
+inf-nifti)
+  # NIfTI's library would read the infinite voxels as 0.
+  phantom image.nii --outside inf
+  segment --image image.nii --output out.vtk
+  refused "image '[^']*image.nii' has a non-finite value \(inf\) at voxel \(0, 0, 0\)" out.vtk ;;
+nan-nifti-gz)
+  phantom image.nii.gz --pixel double --inside nan
+  segment --image image.nii.gz --output out.vtk
+  refused "image '[^']*image.nii.gz' has a non-finite value \(nan\)" out.vtk ;;
+truncated-dicom-slice)
+  "$TOOL" dicom dicom --size 24,24,24 --spacing 1,1,1 --origin 0,0,0 --center 12,12,12 --radii 6,6,6 > /dev/null ||
+    fail "edmodelTestTool dicom"
+  truncate_to dicom/slice1005.dcm 85
+  segment --image dicom --output out.vtk
+  refused "cannot read DICOM series in '[^']*dicom': '[^']*slice1005.dcm' is truncated" out.vtk ;;
 double-1e300)
   phantom image.mha --pixel double --inside 1e300
   segment --image image.mha --output out.vtk
