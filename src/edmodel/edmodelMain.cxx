@@ -209,7 +209,9 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
   t.push_back({ io,
                 "--snapshots",
                 "DIR",
-                "write the mesh every K iterations and a ParaView .pvd time series into DIR (needs a build with VTK)",
+                "write the mesh every K iterations and a ParaView .pvd time series into DIR (needs a build with VTK); "
+                "the series appears when the run succeeds (an interrupted or failed run leaves none of its files) and "
+                "replaces an earlier series of the same name in DIR",
                 "",
                 [&o](const std::string & s) { o.snapshots = s; } });
   t.push_back({ io,

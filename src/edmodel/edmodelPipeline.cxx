@@ -440,7 +440,7 @@ RunSegment(const SegmentOptions & o, const GlobalOptions & global)
   }
 
   Progress           progress(global.quiet);
-  ImageType::Pointer image = ReadImage(o.image);
+  ImageType::Pointer image = ReadImage(o.image, o.gradientVectorFlow);
   MeshType::Pointer  initial;
   if (!o.initMesh.empty())
   {

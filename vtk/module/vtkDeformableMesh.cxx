@@ -36,6 +36,7 @@
 #include "vtkPointData.h"
 #include "vtkPolyData.h"
 
+#include <new>
 #include <vector>
 
 vtkStandardNewMacro(vtkDeformableMesh);
@@ -167,6 +168,12 @@ vtkDeformableMesh::PrepareFilter(vtkInformationVector ** inputVector)
     catch (const itk::ExceptionObject & error)
     {
       vtkErrorMacro("Cannot convert the force image: " << error.GetDescription());
+      internals.ForceImage = nullptr;
+      return 0;
+    }
+    catch (const std::bad_alloc &)
+    {
+      vtkErrorMacro("Out of memory converting the force image of " << image->GetNumberOfPoints() << " voxels.");
       internals.ForceImage = nullptr;
       return 0;
     }

@@ -35,6 +35,7 @@
 #include "vtkStreamingDemandDrivenPipeline.h"
 
 #include <cmath>
+#include <new>
 
 vtkStandardNewMacro(vtkExternalForceField);
 
@@ -151,6 +152,12 @@ vtkExternalForceField::RequestData(vtkInformation *,
   catch (const itk::ExceptionObject & error)
   {
     vtkErrorMacro("The ITK filter failed: " << error.GetDescription());
+    output->Initialize();
+    return 0;
+  }
+  catch (const std::bad_alloc &)
+  {
+    vtkErrorMacro("Out of memory computing the force field of " << input->GetNumberOfPoints() << " voxels.");
     output->Initialize();
     return 0;
   }

@@ -44,7 +44,8 @@
  * Errors (vtkErrorMacro and an empty output): no input array, an array with
  * more than one component, an image that is not three-dimensional, an invalid
  * parameter (negative Sigma, non-positive regularisation), any exception of
- * the ITK filter.
+ * the ITK filter (a Sigma beyond the image's largest extent, NaN or infinite
+ * intensities), a failed memory allocation. No parameter value crashes.
  *
  * @sa vtkDeformableMesh itk::ExternalForceImageFilter
  */
@@ -61,7 +62,8 @@ public:
   /**
    * Standard deviation of the Gaussian smoothing, in physical units. It sets
    * the capture range of the plain gradient force (about 2 to 3 Sigma on
-   * each side of an edge); 0 disables smoothing. Non-negative. Default: 1.0.
+   * each side of an edge); 0 disables smoothing. Non-negative, at most the
+   * largest physical extent of the input. Default: 1.0.
    */
   vtkSetClampMacro(Sigma, double, 0.0, VTK_DOUBLE_MAX);
   vtkGetMacro(Sigma, double);
