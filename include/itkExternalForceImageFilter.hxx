@@ -611,7 +611,8 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::DiffuseGradientVectorFlow(O
       },
       nullptr);
     current.swap(next);
-    this->UpdateProgress(static_cast<float>(iteration + 1) / m_GradientVectorFlowIterations);
+    // The diffusion is the last 70 % of the work, after the smoothing.
+    this->UpdateProgress(0.3f + 0.7f * static_cast<float>(iteration + 1) / m_GradientVectorFlowIterations);
   }
   std::copy(current.begin(), current.end(), field->GetBufferPointer());
 }

@@ -40,7 +40,8 @@ class vtkImageData;
  *   vectors of port 1.
  *
  * The parameters and their defaults are the ITK filter's (the constructor
- * reads the defaults from it).
+ * reads the defaults from it); itk::DeformableMeshFilter documents each one
+ * in full, this header gives units, range and default.
  *
  * At each iteration every vertex x_i moves by
  *   s F(x_i) + a E_i + b R_i + beta n_i
@@ -88,10 +89,9 @@ public:
 
   ///@{
   /**
-   * Weight s of the external force: a vertex moves by s times the sampled
-   * force per iteration. With a force field normalised to a largest length of
-   * 1 (itk::ExternalForceImageFilter's default), s is the largest external
-   * displacement per iteration in physical units. Finite. Default: 1.0.
+   * Weight s of the external force; with a normalised force field, the largest
+   * external displacement per iteration. Millimetres; finite; default 1.0.
+   * Meaning in full: itk::DeformableMeshFilter::SetScaleFactor().
    */
   vtkSetMacro(ScaleFactor, double);
   vtkGetMacro(ScaleFactor, double);
@@ -99,8 +99,9 @@ public:
 
   ///@{
   /**
-   * Weight a of the elastic (membrane) force pulling each vertex toward the
-   * centroid of its neighbours; dimensionless, in [0, 1]. Default: 0.
+   * Weight a of the elastic (membrane) force toward the neighbours' centroid.
+   * Dimensionless, [0, 1]; default 0.
+   * Meaning in full: itk::DeformableMeshFilter::SetElasticity().
    */
   vtkSetClampMacro(Elasticity, double, 0.0, 1.0);
   vtkGetMacro(Elasticity, double);
@@ -108,8 +109,9 @@ public:
 
   ///@{
   /**
-   * When on (default), the elastic force keeps only its component tangent to
-   * the surface (it spreads the vertices without shrinking the surface).
+   * Keep only the part of the elastic force tangent to the surface (no
+   * shrinking). Default on.
+   * Meaning in full: itk::DeformableMeshFilter::SetTangentialElasticity().
    */
   vtkSetMacro(TangentialElasticity, vtkTypeBool);
   vtkGetMacro(TangentialElasticity, vtkTypeBool);
@@ -118,8 +120,9 @@ public:
 
   ///@{
   /**
-   * Weight b of the rigidity (bending) force; dimensionless, in [0, 1]
-   * (a + 2b above 1 is scaled down to 1 by the ITK filter). Default: 0.
+   * Weight b of the rigidity (bending) force. Dimensionless, [0, 1] (a + 2b
+   * above 1 is scaled down to 1); default 0.
+   * Meaning in full: itk::DeformableMeshFilter::SetRigidity().
    */
   vtkSetClampMacro(Rigidity, double, 0.0, 1.0);
   vtkGetMacro(Rigidity, double);
@@ -127,10 +130,10 @@ public:
 
   ///@{
   /**
-   * Balloon force: displacement along the outward unit normal per iteration,
-   * in physical units; positive inflates, negative deflates. The ITK filter
-   * releases it for a vertex once the external force opposes it at least as
-   * strongly, so that the vertex settles on the edge. Default: 0.
+   * Inflation along the outward normal per iteration, released at a vertex
+   * once the external force opposes it with at least half its strength;
+   * negative deflates. Millimetres per iteration; finite; default 0.
+   * Meaning in full: itk::DeformableMeshFilter::SetBalloon().
    */
   vtkSetMacro(Balloon, double);
   vtkGetMacro(Balloon, double);
@@ -138,8 +141,9 @@ public:
 
   ///@{
   /**
-   * Upper bound on a vertex's displacement per iteration, physical units;
-   * 0 means no bound. Non-negative. Default: 0.
+   * Bound on a vertex's displacement per iteration; 0: no bound.
+   * Millimetres, at least 0; default 0.
+   * Meaning in full: itk::DeformableMeshFilter::SetMaximumStepLength().
    */
   vtkSetClampMacro(MaximumStepLength, double, 0.0, VTK_DOUBLE_MAX);
   vtkGetMacro(MaximumStepLength, double);
@@ -147,8 +151,9 @@ public:
 
   ///@{
   /**
-   * Convergence threshold on the largest vertex displacement of an
-   * iteration, physical units; 0 (default) disables convergence detection.
+   * Stop when the largest displacement stays below it for ConvergenceWindow
+   * iterations; 0: never. Millimetres, at least 0; default 0.
+   * Meaning in full: itk::DeformableMeshFilter::SetConvergenceTolerance().
    */
   vtkSetClampMacro(ConvergenceTolerance, double, 0.0, VTK_DOUBLE_MAX);
   vtkGetMacro(ConvergenceTolerance, double);
@@ -156,8 +161,9 @@ public:
 
   ///@{
   /**
-   * Number of consecutive iterations below ConvergenceTolerance that declare
-   * convergence. At least 1. Default: 3.
+   * Consecutive iterations below ConvergenceTolerance that declare
+   * convergence. At least 1; default 3.
+   * Meaning in full: itk::DeformableMeshFilter::SetConvergenceWindow().
    */
   vtkSetClampMacro(ConvergenceWindow, int, 1, VTK_INT_MAX);
   vtkGetMacro(ConvergenceWindow, int);
@@ -201,7 +207,7 @@ protected:
   double      Balloon = 0.0;
   double      MaximumStepLength = 0.0;
   double      ConvergenceTolerance = 0.0;
-  int         ConvergenceWindow = 5;
+  int         ConvergenceWindow = 3;
   vtkTypeBool ComputeDiagnostics = 1;
   vtkTypeBool Converged = 0;
   double      LastMaximumDisplacement = 0.0;
