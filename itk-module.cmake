@@ -13,6 +13,7 @@ itk_module(ExplicitDeformableModel
     ITKCommon
     ITKImageGradient
     ITKMesh
+    ITKSmoothing
   PRIVATE_DEPENDS
     ITKIOGDCM
     ITKIOImageBase

@@ -86,6 +86,13 @@ endif()
 if(BUILD_PARAVIEW_PLUGIN AND NOT ITK_SOURCE_DIR)
   add_subdirectory(paraview)
 endif()
+# Validation on real scans (validation/): the standalone build, whose ITK
+# components include the scoring tool's ITKDistanceMap and ITKThresholding.
+if(NOT EDM_ITK_MODULE_SYSTEM)
+  add_subdirectory(validation)
+else()
+  message(STATUS "ExplicitDeformableModel: the real-image validation (validation/) builds standalone only.")
+endif()
 
 # Benchmarks (bench/, Google Benchmark): on by default when benchmark is found
 # and the ITK has ITKDeformableMesh, the reference of the comparison.

@@ -5,7 +5,7 @@ include(CTest)
 # The modules of itk-module.cmake: DEPENDS (the headers), PRIVATE_DEPENDS
 # (the IO of edmodel and the examples) and, for the tests, TEST_DEPENDS.
 set(EDM_ITK_COMPONENTS
-  ITKCommon ITKMesh ITKImageGradient
+  ITKCommon ITKMesh ITKImageGradient ITKSmoothing ITKDistanceMap ITKThresholding
   ITKIOImageBase ITKIOMeshBase ITKIOMeshVTK ITKIOMeshOBJ ITKIOMeshOFF ITKIOMeshGifti
   ITKIONIFTI ITKIONRRD ITKIOMeta ITKIOGDCM ITKIOPNG)
 if(BUILD_TESTING)

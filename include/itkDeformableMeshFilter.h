@@ -21,6 +21,7 @@
 #include "itkIterativeMeshFilter.h"
 #include "itkImage.h"
 #include "itkDeformableMeshFilterDetail.h"
+#include "itkDeformableMeshRegionForce.h"
 #include "itkForceImageCheck.h"
 
 #include <cstdint>
@@ -171,6 +172,69 @@ public:
   itkSetMacro(Balloon, double);
   itkGetConstMacro(Balloon, double);
 
+  /** The intensity image of the region force: a 3-D scalar image in the same
+   * physical space as the force image (typically the image the force field
+   * was computed from). Optional; needed when RegionWeight > 0. */
+  using IntensityImageType = Image<float, 3>;
+  itkSetInputMacro(IntensityImage, IntensityImageType);
+  itkGetInputMacro(IntensityImage, IntensityImageType);
+
+  /** Weight of the region force, the largest outward (inflation) or inward
+   * (deflation) displacement per iteration it gives, in physical units (mm).
+   * Each vertex inflates where the intensity at its position (the intensity
+   * image smoothed by RegionSigma) lies inside the object's intensity range
+   * and deflates where it lies outside, in proportion to its margin from the
+   * range's bounds (DeformableMeshFilterDetail::RegionForce), so that the
+   * surface settles on the iso-surface of the bound that separates the object
+   * from its surroundings and stays there whatever the number of iterations:
+   * unlike the balloon, it needs no edge to stop it. A vertex outside the
+   * image deflates. Non-negative; 0 turns the region force off. Default: 0. */
+  itkSetMacro(RegionWeight, double);
+  itkGetConstMacro(RegionWeight, double);
+
+  /** Standard deviation of the Gaussian smoothing of the intensity image for
+   * the region force, physical units (mm): thin dark or bright structures
+   * narrower than about 2 sigma (sulci, vessels, noise) no longer stop the
+   * surface. 0: no smoothing. Non-negative. Default: 1. */
+  itkSetMacro(RegionSigma, double);
+  itkGetConstMacro(RegionSigma, double);
+
+  /** Half-width of the object's intensity range in robust standard
+   * deviations of the intensities sampled inside the initial surface, when
+   * the range is estimated (EstimateObjectIntensityRange on): the range is
+   * median +- IntensityTolerance x 1.4826 x MAD. Positive. Default: 2.5. */
+  itkSetMacro(IntensityTolerance, double);
+  itkGetConstMacro(IntensityTolerance, double);
+
+  /** When on (default), the object's intensity range is estimated at each
+   * reset from the interior of the input (initial) surface: intensities
+   * sampled between 10 % and 60 % of the way from each vertex toward the
+   * vertices' centroid, so a surface that is star-shaped around its centroid
+   * and lies inside the object samples the object only. When off, the range
+   * given by SetObjectIntensityRange() is used. */
+  itkSetMacro(EstimateObjectIntensityRange, bool);
+  itkGetConstMacro(EstimateObjectIntensityRange, bool);
+  itkBooleanMacro(EstimateObjectIntensityRange);
+
+  /** The object's intensity range [lower, upper] for the region force, in the
+   * intensity image's units, and the transition width (intensity units, > 0)
+   * over which the speed goes from full deflation to full inflation. Turns
+   * EstimateObjectIntensityRange off. For a bright object on a dark
+   * background give an upper bound above the image's maximum. */
+  void
+  SetObjectIntensityRange(double lower, double upper, double width)
+  {
+    m_ObjectIntensityLower = lower;
+    m_ObjectIntensityUpper = upper;
+    m_ObjectIntensityWidth = width;
+    m_EstimateObjectIntensityRange = false;
+    this->Modified();
+  }
+  /** The range in use: as set, or as estimated at the last reset. */
+  itkGetConstMacro(ObjectIntensityLower, double);
+  itkGetConstMacro(ObjectIntensityUpper, double);
+  itkGetConstMacro(ObjectIntensityWidth, double);
+
   /** Upper bound on the length of a vertex's displacement per iteration, in
    * physical units; 0 means no bound. Useful with raw (unnormalised) force
    * fields. Must be finite and non-negative. Default: 0. */
@@ -257,20 +321,33 @@ private:
   void
   PrepareForceSampler();
 
-  /** True when a term of the intensity image (region force, edge search) is
-   * on: the step then adds m_NormalSpeeds along each vertex's unit normal. */
+  /** True when a term of the intensity image (region force) is on: the step
+   * then adds m_NormalSpeeds along each vertex's unit normal. */
   bool
   UsesImageTerms() const
   {
-    return false;
+    return m_RegionWeight > 0.0;
   }
+
+  /** The checks of the image terms' parameters (VerifyPreconditions()). */
+  void
+  VerifyImageTermParameters() const;
+
+  /** Smooths the intensity image (when it or RegionSigma changed) and
+   * prepares its sampler; at each update with image terms. */
+  void
+  PrepareImageTerms();
+
+  /** Estimates the object's intensity range from the cached input; at each
+   * reset with image terms. */
+  void
+  EstimateImageTermModel();
 
   /** Fills m_NormalSpeeds (outward speed of each vertex, mm per iteration)
    * from the intensity image, at the current coordinates and the unit
    * normals m_Normals of the geometry pass. */
   void
-  UpdateNormalSpeeds()
-  {}
+  UpdateNormalSpeeds();
 
   double       m_ScaleFactor{ 1.0 };
   double       m_Elasticity{ 0.0 };
@@ -278,6 +355,13 @@ private:
   double       m_Rigidity{ 0.0 };
   double       m_Balloon{ 0.0 };
   double       m_MaximumStepLength{ 0.0 };
+  double       m_RegionWeight{ 0.0 };
+  double       m_RegionSigma{ 1.0 };
+  double       m_IntensityTolerance{ 2.5 };
+  bool         m_EstimateObjectIntensityRange{ true };
+  double       m_ObjectIntensityLower{ 0.0 };
+  double       m_ObjectIntensityUpper{ 0.0 };
+  double       m_ObjectIntensityWidth{ 1.0 };
   double       m_ConvergenceTolerance{ 0.0 };
   unsigned int m_ConvergenceWindow{ 3 };
   /** Finite values and step bound of the force image (bad input). */
@@ -305,13 +389,25 @@ private:
   std::vector<uint8_t> m_ValenceOrder;
 
   // Per-vertex state. Next coordinates: 3 per vertex and a guard value, as
-  // the cached coordinates they are swapped with; umbrella vectors and
+  // the cached coordinates they are swapped with (Reset() appends the guard
+  // to those); umbrella vectors and
   // normals (rigidity only): 4 floats per vertex.
   std::vector<double>  m_NextCoordinates;
   std::vector<float>   m_Umbrella;
   std::vector<float>   m_Normals;
   std::vector<uint8_t> m_BalloonReleased;
   std::vector<float>   m_NormalSpeeds; // image terms only
+
+  // Image terms: the smoothed intensity image (kept while the input image and
+  // RegionSigma are unchanged), its sampler and the object's model.
+  typename IntensityImageType::Pointer             m_SmoothedIntensity;
+  ModifiedTimeType                                 m_SmoothedIntensityTime{ 0 };
+  const IntensityImageType *                       m_SmoothedIntensitySource{ nullptr };
+  double                                           m_SmoothedIntensitySigma{ -1.0 };
+  DeformableMeshFilterDetail::IntensitySampler     m_IntensitySampler;
+  DeformableMeshFilterDetail::RegionForce          m_RegionForce;
+  double                                           m_IntensityQuantiles[2]{}; // 2nd and 98th percentiles
+  using RegionForceType = DeformableMeshFilterDetail::RegionForce;
   std::vector<float>   m_DisplacementMagnitudes;
   std::vector<float>   m_ExternalForceMagnitudes;
   std::vector<float>   m_InternalForceMagnitudes;

@@ -71,6 +71,7 @@ DeformableMeshFilter<TMesh, TForceImage>::VerifyPreconditions() const
   {
     itkExceptionMacro("ConvergenceTolerance must be finite and non-negative; it is " << m_ConvergenceTolerance << ".");
   }
+  this->VerifyImageTermParameters();
 }
 
 template <typename TMesh, typename TForceImage>
@@ -79,6 +80,10 @@ DeformableMeshFilter<TMesh, TForceImage>::GenerateData()
 {
   this->PrepareForceSampler();
   m_ForceImageCheck.Verify(this->GetForceImage(), m_ScaleFactor, m_Balloon, m_MaximumStepLength);
+  if (this->UsesImageTerms())
+  {
+    this->PrepareImageTerms();
+  }
   Superclass::GenerateData();
 }
 
@@ -423,7 +428,9 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
 {
   this->BuildTopology();
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
-  // As the cached coordinates: 3 per point and a guard value.
+  // The kernels load 4 doubles from a point's 3 coordinates: both arrays
+  // of coordinates, swapped at each step, end with a guard value.
+  this->GetCoordinates().resize(3 * numberOfPoints + 1, 0.0);
   m_NextCoordinates.assign(3 * numberOfPoints + 1, 0.0);
   std::vector<float>().swap(m_Umbrella);
   std::vector<float>().swap(m_Normals);
@@ -434,6 +441,11 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
   m_Converged = false;
   m_QuietIterations = 0;
   m_LastMaximumDisplacement = 0.0;
+  m_NormalSpeeds.clear();
+  if (this->UsesImageTerms())
+  {
+    this->EstimateImageTermModel();
+  }
 }
 
 template <typename TMesh, typename TForceImage>
@@ -578,6 +590,12 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "TangentialElasticity: " << (m_TangentialElasticity ? "On" : "Off") << std::endl;
   os << indent << "Rigidity: " << m_Rigidity << std::endl;
   os << indent << "Balloon: " << m_Balloon << std::endl;
+  os << indent << "RegionWeight: " << m_RegionWeight << std::endl;
+  os << indent << "RegionSigma: " << m_RegionSigma << std::endl;
+  os << indent << "IntensityTolerance: " << m_IntensityTolerance << std::endl;
+  os << indent << "EstimateObjectIntensityRange: " << m_EstimateObjectIntensityRange << std::endl;
+  os << indent << "ObjectIntensityRange: [" << m_ObjectIntensityLower << ", " << m_ObjectIntensityUpper
+     << "], width " << m_ObjectIntensityWidth << std::endl;
   os << indent << "MaximumStepLength: " << m_MaximumStepLength << std::endl;
   os << indent << "ConvergenceTolerance: " << m_ConvergenceTolerance << std::endl;
   os << indent << "ConvergenceWindow: " << m_ConvergenceWindow << std::endl;
@@ -602,5 +620,7 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
 }
 
 } // end namespace itk
+
+#include "itkDeformableMeshFilterImageTerms.hxx"
 
 #endif

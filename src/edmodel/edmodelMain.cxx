@@ -294,11 +294,18 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                   RequireInRange("--elasticity", o.elasticity, 0.0, 1.0);
                 } });
   t.push_back({ model,
+                "--tangential-elasticity",
+                "",
+                "keep only the component of the elastic force tangent to the surface (it then spaces the vertices "
+                "evenly but no longer smooths the surface's shape)",
+                defaults::TangentialElasticity ? "tangential" : "full umbrella (smooths the shape)",
+                [&o](const std::string &) { o.tangentialElasticity = true; } });
+  t.push_back({ model,
                 "--no-tangential-elasticity",
                 "",
-                "use the full umbrella operator (Laplacian smoothing, shrinks convex surfaces) instead of its "
-                "component tangent to the surface",
-                GetCoreDefaults().TangentialElasticity ? "tangential" : "full umbrella",
+                "use the full umbrella operator (Laplacian smoothing: smooths the surface and keeps it from folding; "
+                "shrinks convex surfaces slightly, which the region force balances)",
+                defaults::TangentialElasticity ? "tangential" : "full umbrella",
                 [&o](const std::string &) { o.tangentialElasticity = false; } });
   t.push_back({ model,
                 "--rigidity",
@@ -316,6 +323,68 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                 "inflation along the outward normal per iteration, physical units (mm); negative deflates",
                 FormatNumber(GetCoreDefaults().Balloon),
                 [&o](const std::string & s) { o.balloon = ParseDouble("--balloon", s); } });
+  t.push_back({ model,
+                "--region",
+                "MM",
+                "weight of the region force: largest inflation (inside the object's intensity range) or deflation "
+                "(outside it) per iteration, physical units (mm); stops by itself on the object's boundary; 0 turns "
+                "it off",
+                FormatNumber(defaults::RegionWeight),
+                [&o](const std::string & s) {
+                  o.regionWeight = ParseDouble("--region", s);
+                  RequireAtLeast("--region", o.regionWeight, 0.0);
+                } });
+  t.push_back({ model,
+                "--edge-length",
+                "MM",
+                "mean edge length the surface is refined to: it converges at its initial resolution, then each "
+                "triangle is split into four and it converges again, until its mean edge is at most 1.5 x MM, "
+                "physical units (mm)",
+                FormatNumber(defaults::EdgeLengthInVoxels) + " x the smallest voxel spacing",
+                [&o](const std::string & s) {
+                  o.edgeLength = ParseDouble("--edge-length", s);
+                  if (!(o.edgeLength > 0.0 && std::isfinite(o.edgeLength)))
+                  {
+                    throw Error("--edge-length must be positive and finite, got " + s);
+                  }
+                } });
+  t.push_back({ model,
+                "--region-sigma",
+                "MM",
+                "Gaussian smoothing of the image for the region force, physical units (mm)",
+                FormatNumber(defaults::RegionSigma),
+                [&o](const std::string & s) {
+                  o.regionSigma = ParseDouble("--region-sigma", s);
+                  RequireAtLeast("--region-sigma", o.regionSigma, 0.0);
+                } });
+  t.push_back({ model,
+                "--intensity-tolerance",
+                "K",
+                "half-width of the object's intensity range, estimated inside the initial surface, in robust "
+                "standard deviations (> 0)",
+                FormatNumber(GetCoreDefaults().IntensityTolerance),
+                [&o](const std::string & s) {
+                  o.intensityTolerance = ParseDouble("--intensity-tolerance", s);
+                  if (!(o.intensityTolerance > 0.0))
+                  {
+                    throw Error("--intensity-tolerance must be positive, got " + FormatNumber(o.intensityTolerance));
+                  }
+                } });
+  t.push_back({ model,
+                "--object-range",
+                "LO,HI",
+                "the object's intensity range for the region force, in image units, instead of the estimate",
+                "estimated inside the initial surface",
+                [&o](const std::string & s) {
+                  const auto v = ParseList("--object-range", s, 2, "LO,HI");
+                  if (!(v[0] < v[1]))
+                  {
+                    throw Error("--object-range: LO must be below HI, got " + s);
+                  }
+                  o.objectRange[0] = v[0];
+                  o.objectRange[1] = v[1];
+                  o.hasObjectRange = true;
+                } });
   t.push_back({ model,
                 "--max-step",
                 "MM",

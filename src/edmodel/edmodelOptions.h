@@ -41,6 +41,7 @@ struct CoreDefaults
   double       Balloon;
   double       MaximumStepLength;
   unsigned int ConvergenceWindow;
+  double       IntensityTolerance;
 };
 const CoreDefaults &
 GetCoreDefaults();
@@ -56,15 +57,35 @@ constexpr double SigmaInVoxels = 1.0;
 /** Largest external displacement per iteration, as a fraction of Sigma. */
 constexpr double       ScaleOverSigma = 0.5;
 constexpr double       Elasticity = 0.3;
+/** The full umbrella operator (not only its tangential part, the core's
+ * default): with the region force, the normal part is what keeps the
+ * surface from folding into dark pockets (ventricles, sulci). */
+constexpr bool TangentialElasticity = false;
 constexpr double       Rigidity = 0.05;
 constexpr unsigned int Iterations = 500;
 constexpr double       ConvergenceTolerance = 0.01;
 /** Subdivisions of the octahedron of --init-sphere (4 * 4^n + 2 points). */
-constexpr unsigned int SphereResolution = 4;
+constexpr unsigned int SphereResolution = 3;
 /** Radius of the default initial sphere, as a fraction of the smallest
  * physical extent of the image. */
 constexpr double       SphereRadiusOverExtent = 0.25;
 constexpr unsigned int SnapshotEvery = 10;
+/** Region force: largest inflation or deflation per iteration, as a fraction
+ * of the smallest voxel spacing, and the smoothing of its image in voxels. */
+constexpr double RegionWeightInVoxels = 0.25;
+constexpr double RegionWeight = 0.25; // mm on a 1 mm grid, for the help text
+constexpr double RegionSigmaInVoxels = 1.0;
+constexpr double RegionSigma = 1.0;
+/** Mean edge length the coarse-to-fine refinement aims at, in voxels of the
+ * smallest spacing, and the largest number of points it creates. */
+constexpr double       EdgeLengthInVoxels = 1.0;
+constexpr unsigned int MaximumRefinedPoints = 2000000;
+/** Iteration cap of each refinement level (after the first, which has
+ * --iterations): the refined surface starts on the boundary. */
+constexpr unsigned int RefinementIterations = 500;
+/** The first level's region force sees the image smoothed this many times
+ * more than the later ones. */
+constexpr double CoarseRegionSigmaFactor = 2.0;
 /** The demo adds gradient vector flow to the segment defaults: the seed's
  * sphere starts 12 voxels from the ends of the ellipsoid, beyond the capture
  * range of the plain gradient force at sigma = 1 voxel. */
@@ -125,11 +146,18 @@ struct SegmentOptions
   unsigned int gradientVectorFlowIterations{ GetCoreDefaults().GradientVectorFlowIterations };
 
   double       elasticity{ defaults::Elasticity };
-  bool         tangentialElasticity{ GetCoreDefaults().TangentialElasticity };
+  bool         tangentialElasticity{ defaults::TangentialElasticity };
   double       rigidity{ defaults::Rigidity };
   double       balloon{ GetCoreDefaults().Balloon };
+  double       regionWeight{ -1.0 }; // negative: defaults::RegionWeightInVoxels times the smallest spacing
+  double       regionSigma{ -1.0 };  // negative: defaults::RegionSigmaInVoxels times the smallest spacing
+  double       intensityTolerance{ GetCoreDefaults().IntensityTolerance };
+  double       edgeLength{ -1.0 }; // non-positive: defaults::EdgeLengthInVoxels times the smallest spacing
+  bool         hasObjectRange{ false };
+  double       objectRange[2]{ 0.0, 0.0 };
   double       maximumStepLength{ GetCoreDefaults().MaximumStepLength };
   unsigned int iterations{ defaults::Iterations };
+  unsigned int refinementIterations{ defaults::RefinementIterations };
   double       convergenceTolerance{ defaults::ConvergenceTolerance };
   unsigned int convergenceWindow{ GetCoreDefaults().ConvergenceWindow };
   unsigned int snapshotEvery{ defaults::SnapshotEvery };

@@ -20,6 +20,7 @@
 #include <functional>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <unistd.h>
@@ -250,6 +251,93 @@ CheckInitialMesh(const ImageType * image, const MeshType * mesh, const std::stri
   }
 }
 
+/** Mean length of the edges of the mesh's triangles (each edge counted once
+ * per triangle side), physical units. */
+double
+MeanEdgeLength(const MeshType * mesh)
+{
+  double sum = 0.0;
+  size_t count = 0;
+  for (auto cell = mesh->GetCells()->Begin(); cell != mesh->GetCells()->End(); ++cell)
+  {
+    const auto * c = cell.Value();
+    if (c->GetNumberOfPoints() != 3)
+    {
+      continue;
+    }
+    const auto * ids = c->GetPointIds();
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      sum += mesh->GetPoint(ids[k]).EuclideanDistanceTo(mesh->GetPoint(ids[(k + 1) % 3]));
+      ++count;
+    }
+  }
+  return count > 0 ? sum / static_cast<double>(count) : 0.0;
+}
+
+/** Each triangle split into four at the midpoints of its edges (orientation
+ * kept); other cells are dropped. */
+MeshType::Pointer
+SubdivideTriangles(const MeshType * mesh)
+{
+  using CellType = MeshType::CellType;
+  using TriangleType = itk::TriangleCell<CellType>;
+  auto output = MeshType::New();
+  auto points = MeshType::PointsContainer::New();
+  points->Reserve(mesh->GetNumberOfPoints());
+  for (auto it = mesh->GetPoints()->Begin(); it != mesh->GetPoints()->End(); ++it)
+  {
+    points->SetElement(it.Index(), it.Value());
+  }
+  itk::IdentifierType                         next = mesh->GetNumberOfPoints();
+  std::map<std::pair<itk::IdentifierType, itk::IdentifierType>, itk::IdentifierType> midpoints;
+  const auto midpoint = [&](itk::IdentifierType a, itk::IdentifierType b) {
+    const auto key = std::make_pair(std::min(a, b), std::max(a, b));
+    const auto found = midpoints.find(key);
+    if (found != midpoints.end())
+    {
+      return found->second;
+    }
+    MeshType::PointType p;
+    const auto &        pa = points->ElementAt(a);
+    const auto &        pb = points->ElementAt(b);
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      p[k] = 0.5 * (pa[k] + pb[k]);
+    }
+    points->InsertElement(next, p);
+    midpoints.emplace(key, next);
+    return next++;
+  };
+  output->SetPoints(points);
+  itk::IdentifierType cellId = 0;
+  const auto          addTriangle = [&](itk::IdentifierType a, itk::IdentifierType b, itk::IdentifierType c) {
+    CellType::CellAutoPointer cell;
+    cell.TakeOwnership(new TriangleType);
+    cell->SetPointId(0, a);
+    cell->SetPointId(1, b);
+    cell->SetPointId(2, c);
+    output->SetCell(cellId++, cell);
+  };
+  for (auto cell = mesh->GetCells()->Begin(); cell != mesh->GetCells()->End(); ++cell)
+  {
+    const auto * c = cell.Value();
+    if (c->GetNumberOfPoints() != 3)
+    {
+      continue;
+    }
+    const auto * ids = c->GetPointIds();
+    const auto   ab = midpoint(ids[0], ids[1]);
+    const auto   bc = midpoint(ids[1], ids[2]);
+    const auto   ca = midpoint(ids[2], ids[0]);
+    addTriangle(ids[0], ab, ca);
+    addTriangle(ab, ids[1], bc);
+    addTriangle(ca, bc, ids[2]);
+    addTriangle(ab, bc, ca);
+  }
+  return output;
+}
+
 struct DeformResult
 {
   MeshType::Pointer       mesh;
@@ -303,61 +391,114 @@ Deform(const ImageType *        image,
   progress.Finish("sigma " + Format(result.sigma) + " mm" + (o.gradientVectorFlow ? ", gradient vector flow" : "") +
                   (o.normalizeForces ? ", normalised" : ", not normalised") + " (" + Format(seconds(), 2) + " s)");
 
-  auto deform = DeformFilterType::New();
-  deform->SetInput(initial);
-  deform->SetForceImage(result.force);
-  deform->SetScaleFactor(result.scale);
-  deform->SetElasticity(o.elasticity);
-  deform->SetTangentialElasticity(o.tangentialElasticity);
-  deform->SetRigidity(o.rigidity);
-  deform->SetBalloon(o.balloon);
-  deform->SetMaximumStepLength(o.maximumStepLength);
-  deform->SetConvergenceTolerance(o.convergenceTolerance);
-  deform->SetConvergenceWindow(o.convergenceWindow);
-  deform->SetNumberOfIterations(o.iterations);
-  progress.Start("deforming");
-  const auto deformStart = std::chrono::steady_clock::now();
-  deform->AddObserver(itk::ProgressEvent(), [&](const itk::EventObject &) {
-    const auto total = deform->GetNumberOfIterations();
-    const auto current = deform->GetCurrentIteration();
-    progress.Update(total > 0 ? static_cast<double>(current) / total : 1.0,
-                    "iteration " + std::to_string(current) + "/" + std::to_string(total) + ", largest step " +
-                      Format(deform->GetLastMaximumDisplacement()) + " mm");
-  });
+  // Coarse to fine: the surface first converges at the resolution it is
+  // given (the coarse default sphere, whose long edges bridge pockets such as
+  // ventricles and sulci that would trap a fine mesh), on an image smoothed
+  // twice as much for the region force; it is then subdivided (each triangle
+  // into four) and deformed again, until its mean edge length reaches
+  // --edge-length. The object's intensity range is estimated once, from the
+  // initial surface.
+  const double regionWeight =
+    o.regionWeight >= 0.0 ? o.regionWeight : defaults::RegionWeightInVoxels * SmallestSpacing(image);
+  const double regionSigma =
+    o.regionSigma >= 0.0 ? o.regionSigma : defaults::RegionSigmaInVoxels * SmallestSpacing(image);
+  const double edgeLength =
+    o.edgeLength > 0.0 ? o.edgeLength : defaults::EdgeLengthInVoxels * SmallestSpacing(image);
+  MeshType::ConstPointer stageInput = initial;
+  bool                   haveRange = o.hasObjectRange;
+  double                 range[3] = { o.objectRange[0], o.objectRange[1], 0.1 * (o.objectRange[1] - o.objectRange[0]) };
+  itk::SizeValueType     iterationsBefore = 0;
   if (snapshot)
   {
     snapshot(initial, 0);
-    deform->AddObserver(itk::IterationEvent(), [&](const itk::EventObject &) {
-      if (deform->GetCurrentIteration() % o.snapshotEvery == 0)
-      {
-        snapshot(deform->GetOutput(), deform->GetCurrentIteration());
-      }
+  }
+  for (unsigned int stage = 0;; ++stage)
+  {
+    auto deform = DeformFilterType::New();
+    // The last level: refinement off (no region force), or a first level
+    // already fine enough (later levels are decided on their output below).
+    bool last = regionWeight == 0.0 || !(MeanEdgeLength(stageInput) > 1.5 * edgeLength);
+    deform->SetInput(stageInput);
+    deform->SetForceImage(result.force);
+    deform->SetScaleFactor(result.scale);
+    deform->SetElasticity(o.elasticity);
+    deform->SetTangentialElasticity(o.tangentialElasticity);
+    deform->SetRigidity(o.rigidity);
+    deform->SetBalloon(o.balloon);
+    deform->SetIntensityImage(image);
+    deform->SetRegionWeight(regionWeight);
+    deform->SetRegionSigma(stage == 0 && !last ? defaults::CoarseRegionSigmaFactor * regionSigma : regionSigma);
+    deform->SetIntensityTolerance(o.intensityTolerance);
+    if (haveRange)
+    {
+      deform->SetObjectIntensityRange(range[0], range[1], range[2]);
+    }
+    deform->SetMaximumStepLength(o.maximumStepLength);
+    deform->SetConvergenceTolerance(o.convergenceTolerance);
+    deform->SetConvergenceWindow(o.convergenceWindow);
+    deform->SetNumberOfIterations(stage == 0 ? o.iterations : std::min(o.iterations, o.refinementIterations));
+    const std::string level = std::to_string(stageInput->GetNumberOfPoints()) + " points";
+    progress.Start("deforming");
+    const auto deformStart = std::chrono::steady_clock::now();
+    deform->AddObserver(itk::ProgressEvent(), [&](const itk::EventObject &) {
+      const auto total = deform->GetNumberOfIterations();
+      const auto current = deform->GetCurrentIteration();
+      progress.Update(total > 0 ? static_cast<double>(current) / total : 1.0,
+                      level + ", iteration " + std::to_string(current) + "/" + std::to_string(total) +
+                        ", largest step " + Format(deform->GetLastMaximumDisplacement()) + " mm");
     });
+    if (snapshot)
+    {
+      deform->AddObserver(itk::IterationEvent(), [&](const itk::EventObject &) {
+        if (deform->GetCurrentIteration() % o.snapshotEvery == 0)
+        {
+          snapshot(deform->GetOutput(), iterationsBefore + deform->GetCurrentIteration());
+        }
+      });
+    }
+    try
+    {
+      deform->Update();
+    }
+    catch (const itk::ExceptionObject & exception)
+    {
+      throw Error("deformation: " + OneLine(exception.GetDescription()));
+    }
+    if (deform->GetRegionWeight() > 0.0 && !haveRange)
+    {
+      haveRange = true;
+      range[0] = deform->GetObjectIntensityLower();
+      range[1] = deform->GetObjectIntensityUpper();
+      range[2] = deform->GetObjectIntensityWidth();
+      progress.Note("region force: object intensity range [" + Format(range[0], 4) + ", " + Format(range[1], 4) +
+                    "], transition width " + Format(range[2], 3) + " (estimated inside the initial surface)");
+    }
+    if (snapshot && deform->GetCurrentIteration() % o.snapshotEvery != 0)
+    {
+      snapshot(deform->GetOutput(), iterationsBefore + deform->GetCurrentIteration());
+    }
+    result.iterations += deform->GetCurrentIteration();
+    iterationsBefore = result.iterations;
+    result.converged = deform->GetConverged();
+    result.lastMaximumDisplacement = deform->GetLastMaximumDisplacement();
+    const double deformSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - deformStart).count();
+    progress.Finish(std::to_string(deform->GetCurrentIteration()) + " iterations on " + level + ", " +
+                    (result.converged ? "converged (largest step below " + Format(o.convergenceTolerance) +
+                                          " mm for " + std::to_string(o.convergenceWindow) + " iterations)"
+                                      : std::string("iteration cap reached")) +
+                    ", last largest step " + Format(result.lastMaximumDisplacement) + " mm (" +
+                    Format(deformSeconds, 2) + " s)");
+    MeshType::Pointer output = deform->GetOutput();
+    output->DisconnectPipeline();
+    last = last || !(MeanEdgeLength(output) > 1.5 * edgeLength) ||
+           4 * output->GetNumberOfPoints() > defaults::MaximumRefinedPoints;
+    if (last)
+    {
+      result.mesh = output;
+      break;
+    }
+    stageInput = SubdivideTriangles(output);
   }
-  try
-  {
-    deform->Update();
-  }
-  catch (const itk::ExceptionObject & exception)
-  {
-    throw Error("deformation: " + OneLine(exception.GetDescription()));
-  }
-  if (snapshot && deform->GetCurrentIteration() % o.snapshotEvery != 0)
-  {
-    snapshot(deform->GetOutput(), deform->GetCurrentIteration());
-  }
-  result.mesh = deform->GetOutput();
-  result.mesh->DisconnectPipeline();
-  result.iterations = deform->GetCurrentIteration();
-  result.converged = deform->GetConverged();
-  result.lastMaximumDisplacement = deform->GetLastMaximumDisplacement();
-  const double deformSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - deformStart).count();
-  progress.Finish(std::to_string(result.iterations) + " iterations, " +
-                  (result.converged ? "converged (largest step below " + Format(o.convergenceTolerance) + " mm for " +
-                                        std::to_string(o.convergenceWindow) + " iterations)"
-                                    : std::string("iteration cap reached")) +
-                  ", last largest step " + Format(result.lastMaximumDisplacement) + " mm (" + Format(deformSeconds, 2) +
-                  " s)");
   return result;
 }
 
@@ -389,6 +530,7 @@ GetCoreDefaults()
     d.Balloon = deform->GetBalloon();
     d.MaximumStepLength = deform->GetMaximumStepLength();
     d.ConvergenceWindow = deform->GetConvergenceWindow();
+    d.IntensityTolerance = deform->GetIntensityTolerance();
     return d;
   }();
   return defaults;

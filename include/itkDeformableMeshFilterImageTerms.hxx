@@ -1,0 +1,157 @@
+/*=========================================================================
+ *
+ *  Copyright NumFOCUS
+ *
+ *  Licensed under the Apache License, Version 2.0 (the "License");
+ *  you may not use this file except in compliance with the License.
+ *  You may obtain a copy of the License at
+ *
+ *         http://www.apache.org/licenses/LICENSE-2.0.txt
+ *
+ *  Unless required by applicable law or agreed to in writing, software
+ *  distributed under the License is distributed on an "AS IS" BASIS,
+ *  WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+ *  See the License for the specific language governing permissions and
+ *  limitations under the License.
+ *
+ *=========================================================================*/
+#ifndef itkDeformableMeshFilterImageTerms_hxx
+#define itkDeformableMeshFilterImageTerms_hxx
+
+// The image terms of DeformableMeshFilter (region force): their parameters'
+// checks, the smoothed intensity image, the object's intensity model and the
+// per-vertex outward speeds the step adds along the normals. Included by
+// itkDeformableMeshFilter.hxx.
+
+#include "itkSmoothingRecursiveGaussianImageFilter.h"
+
+namespace itk
+{
+
+template <typename TMesh, typename TForceImage>
+void
+DeformableMeshFilter<TMesh, TForceImage>::VerifyImageTermParameters() const
+{
+  if (!(m_RegionWeight >= 0.0 && std::isfinite(m_RegionWeight)))
+  {
+    itkExceptionMacro("RegionWeight must be finite and non-negative; it is " << m_RegionWeight << ".");
+  }
+  if (!(m_RegionSigma >= 0.0 && std::isfinite(m_RegionSigma)))
+  {
+    itkExceptionMacro("RegionSigma must be finite and non-negative; it is " << m_RegionSigma << ".");
+  }
+  if (!(m_IntensityTolerance > 0.0 && std::isfinite(m_IntensityTolerance)))
+  {
+    itkExceptionMacro("IntensityTolerance must be finite and positive; it is " << m_IntensityTolerance << ".");
+  }
+  if (!m_EstimateObjectIntensityRange &&
+      !(std::isfinite(m_ObjectIntensityLower) && std::isfinite(m_ObjectIntensityUpper) &&
+        m_ObjectIntensityLower <= m_ObjectIntensityUpper && m_ObjectIntensityWidth > 0.0 &&
+        std::isfinite(m_ObjectIntensityWidth)))
+  {
+    itkExceptionMacro("The object intensity range must be finite with lower <= upper and a positive width; it is ["
+                      << m_ObjectIntensityLower << ", " << m_ObjectIntensityUpper << "], width "
+                      << m_ObjectIntensityWidth << ".");
+  }
+  if (m_RegionWeight > 0.0 && this->GetIntensityImage() == nullptr)
+  {
+    itkExceptionMacro("RegionWeight is " << m_RegionWeight
+                                         << " but there is no intensity image: call SetIntensityImage().");
+  }
+}
+
+template <typename TMesh, typename TForceImage>
+void
+DeformableMeshFilter<TMesh, TForceImage>::PrepareImageTerms()
+{
+  const IntensityImageType * image = this->GetIntensityImage();
+  if (image->GetBufferedRegion().GetNumberOfPixels() == 0 || image->GetBufferPointer() == nullptr)
+  {
+    itkExceptionMacro("The intensity image has no buffered region (no pixel in memory): allocate it or update the "
+                      "filter that produces it.");
+  }
+  if (m_SmoothedIntensity.IsNull() || m_SmoothedIntensitySource != image ||
+      m_SmoothedIntensityTime != image->GetMTime() || m_SmoothedIntensitySigma != m_RegionSigma)
+  {
+    if (m_RegionSigma > 0.0)
+    {
+      using SmoothingType = SmoothingRecursiveGaussianImageFilter<IntensityImageType, IntensityImageType>;
+      auto smoothing = SmoothingType::New();
+      smoothing->SetInput(image);
+      smoothing->SetSigma(m_RegionSigma);
+      smoothing->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
+      smoothing->Update();
+      m_SmoothedIntensity = smoothing->GetOutput();
+      m_SmoothedIntensity->DisconnectPipeline();
+    }
+    else
+    {
+      m_SmoothedIntensity = IntensityImageType::New();
+      m_SmoothedIntensity->Graft(image);
+    }
+    m_SmoothedIntensitySource = image;
+    m_SmoothedIntensityTime = image->GetMTime();
+    m_SmoothedIntensitySigma = m_RegionSigma;
+    const std::vector<double> quantiles = RegionForceType::Quantiles(m_SmoothedIntensity, { 0.02, 0.98 });
+    m_IntensityQuantiles[0] = quantiles[0];
+    m_IntensityQuantiles[1] = quantiles[1];
+  }
+  m_IntensitySampler.SetImage(m_SmoothedIntensity);
+}
+
+template <typename TMesh, typename TForceImage>
+void
+DeformableMeshFilter<TMesh, TForceImage>::EstimateImageTermModel()
+{
+  using namespace DeformableMeshFilterDetail;
+  if (m_EstimateObjectIntensityRange)
+  {
+    const std::vector<double> samples =
+      RegionForce::SampleInterior(m_IntensitySampler, this->GetCoordinates().data(), this->GetNumberOfCachedPoints());
+    if (!m_RegionForce.Estimate(samples, m_IntensityTolerance, m_IntensityQuantiles[0], m_IntensityQuantiles[1]))
+    {
+      itkExceptionMacro("Cannot estimate the object's intensity range: "
+                        << (samples.empty() ? "the interior of the initial surface lies outside the intensity image"
+                                            : "the intensities inside the initial surface are not finite")
+                        << "; give the range with SetObjectIntensityRange().");
+    }
+    m_ObjectIntensityLower = m_RegionForce.GetLower();
+    m_ObjectIntensityUpper = m_RegionForce.GetUpper();
+    m_ObjectIntensityWidth = m_RegionForce.GetWidth();
+  }
+  else
+  {
+    m_RegionForce.SetRange(m_ObjectIntensityLower, m_ObjectIntensityUpper, m_ObjectIntensityWidth);
+  }
+}
+
+template <typename TMesh, typename TForceImage>
+void
+DeformableMeshFilter<TMesh, TForceImage>::UpdateNormalSpeeds()
+{
+  const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
+  if (m_NormalSpeeds.size() != numberOfPoints)
+  {
+    m_NormalSpeeds.assign(numberOfPoints, 0.0f);
+  }
+  const double * x = this->GetCoordinates().data();
+  float *        speeds = m_NormalSpeeds.data();
+  const double   weight = m_RegionWeight;
+  constexpr SizeValueType blockSize = 4096;
+  const SizeValueType     numberOfBlocks = (numberOfPoints + blockSize - 1) / blockSize;
+  this->GetMultiThreader()->ParallelizeArray(
+    0,
+    numberOfBlocks,
+    [this, x, speeds, weight, numberOfPoints](SizeValueType block) {
+      const SizeValueType end = std::min(numberOfPoints, (block + 1) * blockSize);
+      for (SizeValueType i = block * blockSize; i < end; ++i)
+      {
+        speeds[i] = static_cast<float>(weight * m_RegionForce.Speed(m_IntensitySampler.Sample(x + 3 * i)));
+      }
+    },
+    nullptr);
+}
+
+} // end namespace itk
+
+#endif

@@ -1,0 +1,302 @@
+/*=========================================================================
+ *
+ *  Copyright NumFOCUS
+ *
+ *  Licensed under the Apache License, Version 2.0 (the "License");
+ *  you may not use this file except in compliance with the License.
+ *  You may obtain a copy of the License at
+ *
+ *         http://www.apache.org/licenses/LICENSE-2.0.txt
+ *
+ *  Unless required by applicable law or agreed to in writing, software
+ *  distributed under the License is distributed on an "AS IS" BASIS,
+ *  WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+ *  See the License for the specific language governing permissions and
+ *  limitations under the License.
+ *
+ *=========================================================================*/
+#ifndef itkDeformableMeshRegionForce_h
+#define itkDeformableMeshRegionForce_h
+
+#include "itkImage.h"
+#include "itkMatrix.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace itk
+{
+namespace DeformableMeshFilterDetail
+{
+
+/** \class IntensitySampler
+ * \brief Trilinear samples of a scalar image at physical points, read
+ * through its buffer with the physical-to-index transform precomputed.
+ *
+ * Same inside test as itk::LinearInterpolateImageFunction (half a voxel
+ * beyond the first and last voxel centres, values clamped at the border);
+ * Sample() returns NaN outside.
+ * \ingroup ExplicitDeformableModel
+ */
+class IntensitySampler
+{
+public:
+  using ImageType = Image<float, 3>;
+
+  void
+  SetImage(const ImageType * image)
+  {
+    m_Buffer = image->GetBufferPointer();
+    const auto region = image->GetBufferedRegion();
+    Matrix<double, 3, 3> indexToPhysical;
+    for (unsigned int r = 0; r < 3; ++r)
+    {
+      for (unsigned int c = 0; c < 3; ++c)
+      {
+        indexToPhysical(r, c) = image->GetDirection()(r, c) * image->GetSpacing()[c];
+      }
+    }
+    const vnl_matrix<double> physicalToIndex = indexToPhysical.GetInverse().as_matrix();
+    for (unsigned int r = 0; r < 3; ++r)
+    {
+      for (unsigned int c = 0; c < 3; ++c)
+      {
+        m_Matrix[r][c] = physicalToIndex(r, c);
+      }
+      m_Size[r] = static_cast<int64_t>(region.GetSize()[r]);
+    }
+    for (unsigned int r = 0; r < 3; ++r)
+    {
+      m_Offset[r] = static_cast<double>(region.GetIndex()[r]);
+      for (unsigned int c = 0; c < 3; ++c)
+      {
+        m_Offset[r] += m_Matrix[r][c] * image->GetOrigin()[c];
+      }
+    }
+  }
+
+  /** The trilinear sample at physical point x; NaN outside the image. */
+  double
+  Sample(const double * x) const
+  {
+    double  c[3];
+    int64_t base[3];
+    double  w[3];
+    for (unsigned int r = 0; r < 3; ++r)
+    {
+      c[r] = m_Matrix[r][0] * x[0] + m_Matrix[r][1] * x[1] + m_Matrix[r][2] * x[2] - m_Offset[r];
+      if (!(c[r] >= -0.5 && c[r] < static_cast<double>(m_Size[r]) - 0.5))
+      {
+        return std::numeric_limits<double>::quiet_NaN();
+      }
+      const double f = std::floor(c[r]);
+      base[r] = static_cast<int64_t>(f);
+      w[r] = c[r] - f;
+    }
+    int64_t lo[3];
+    int64_t hi[3];
+    for (unsigned int r = 0; r < 3; ++r)
+    {
+      lo[r] = std::max<int64_t>(base[r], 0);
+      hi[r] = std::min<int64_t>(base[r] + 1, m_Size[r] - 1);
+    }
+    const int64_t sy = m_Size[0];
+    const int64_t sz = m_Size[0] * m_Size[1];
+    const auto    at = [&](int64_t i, int64_t j, int64_t k) { return static_cast<double>(m_Buffer[i + sy * j + sz * k]); };
+    const double  c00 = at(lo[0], lo[1], lo[2]) + w[0] * (at(hi[0], lo[1], lo[2]) - at(lo[0], lo[1], lo[2]));
+    const double  c10 = at(lo[0], hi[1], lo[2]) + w[0] * (at(hi[0], hi[1], lo[2]) - at(lo[0], hi[1], lo[2]));
+    const double  c01 = at(lo[0], lo[1], hi[2]) + w[0] * (at(hi[0], lo[1], hi[2]) - at(lo[0], lo[1], hi[2]));
+    const double  c11 = at(lo[0], hi[1], hi[2]) + w[0] * (at(hi[0], hi[1], hi[2]) - at(lo[0], hi[1], hi[2]));
+    const double  c0 = c00 + w[1] * (c10 - c00);
+    const double  c1 = c01 + w[1] * (c11 - c01);
+    return c0 + w[2] * (c1 - c0);
+  }
+
+private:
+  const float * m_Buffer{ nullptr };
+  double        m_Matrix[3][3]{};
+  double        m_Offset[3]{};
+  int64_t       m_Size[3]{};
+};
+
+/** \class RegionForce
+ * \brief The region force of DeformableMeshFilter: the outward speed of a
+ * vertex from the intensity at its position, compared with the object's
+ * intensity range.
+ *
+ * With I the (smoothed) intensity at the vertex, [L, U] the object's range
+ * and w the transition width, the speed is
+ * \f[
+ *   v = \rho \, \mathrm{clamp}\left( \frac{\min(I - L,\; U - I)}{w}, -1, 1 \right)
+ * \f]
+ * (\f$ \rho \f$ the RegionWeight, mm per iteration): full inflation deep in
+ * the object's range, full deflation where the intensity is w beyond it, and
+ * zero on the iso-surfaces I = L and I = U, on which the surface therefore
+ * settles whatever the number of iterations. A vertex outside the image
+ * deflates at full speed.
+ *
+ * Estimate() derives the range from the interior of the initial surface:
+ * intensities sampled on the segments from each vertex toward the vertices'
+ * centroid (between 10 % and 60 % of the way); see Estimate() for the
+ * bounds. A bright object on a dark background and a dark object on a bright
+ * one are treated alike, on any intensity range; an initial surface that is
+ * star-shaped around its centroid (a sphere inside the object) samples only
+ * the object.
+ * \ingroup ExplicitDeformableModel
+ */
+class RegionForce
+{
+public:
+  /** Samples of the interior of the surface of coordinates x (3 per vertex):
+   * fractions of the way from each vertex toward the centroid. */
+  static std::vector<double>
+  SampleInterior(const IntensitySampler & sampler, const double * x, size_t numberOfPoints)
+  {
+    double centroid[3] = { 0.0, 0.0, 0.0 };
+    for (size_t i = 0; i < numberOfPoints; ++i)
+    {
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        centroid[k] += x[3 * i + k];
+      }
+    }
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      centroid[k] /= static_cast<double>(numberOfPoints);
+    }
+    std::vector<double> samples;
+    samples.reserve(6 * numberOfPoints);
+    for (size_t i = 0; i < numberOfPoints; ++i)
+    {
+      for (double f = 0.1; f < 0.65; f += 0.1)
+      {
+        double p[3];
+        for (unsigned int k = 0; k < 3; ++k)
+        {
+          p[k] = x[3 * i + k] + f * (centroid[k] - x[3 * i + k]);
+        }
+        const double value = sampler.Sample(p);
+        if (std::isfinite(value))
+        {
+          samples.push_back(value);
+        }
+      }
+    }
+    return samples;
+  }
+
+  /** Sets the range from the samples' median m and robust spread s
+   * (1.4826 times their median absolute deviation): [m - h, m + h] with
+   * h = max(k s, (m - low) / 2, (high - m) / 2), k the tolerance and low,
+   * high the image's 2nd and 98th percentiles. The second and third terms
+   * make a piecewise constant image (no spread inside) place the bound
+   * halfway between the object's intensity and the image's other extreme,
+   * which is where the smoothed image crosses the object's edge. Width:
+   * max(s, h / 4). Returns false when there is no sample. */
+  bool
+  Estimate(std::vector<double> samples, double tolerance, double low, double high)
+  {
+    if (samples.empty())
+    {
+      return false;
+    }
+    const auto median = [](std::vector<double> & v) {
+      const auto middle = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+      std::nth_element(v.begin(), middle, v.end());
+      return *middle;
+    };
+    const double centre = median(samples);
+    for (double & value : samples)
+    {
+      value = std::abs(value - centre);
+    }
+    const double spread = 1.4826 * median(samples);
+    const double halfWidth = std::max({ tolerance * spread, 0.5 * (centre - low), 0.5 * (high - centre) });
+    SetRange(centre - halfWidth, centre + halfWidth, std::max(spread, 0.25 * halfWidth));
+    return std::isfinite(m_Lower) && std::isfinite(m_Upper) && m_Width > 0.0;
+  }
+
+  /** The q-quantiles (q in [0, 1]) of about a million voxels of image,
+   * taken at a regular stride. */
+  static std::vector<double>
+  Quantiles(const Image<float, 3> * image, const std::vector<double> & q)
+  {
+    const float *  buffer = image->GetBufferPointer();
+    const size_t   count = image->GetBufferedRegion().GetNumberOfPixels();
+    const size_t   stride = std::max<size_t>(1, count / 1000000) | 1; // odd: no alignment with rows
+    std::vector<float> values;
+    values.reserve(count / stride + 1);
+    for (size_t i = 0; i < count; i += stride)
+    {
+      if (std::isfinite(buffer[i]))
+      {
+        values.push_back(buffer[i]);
+      }
+    }
+    std::vector<double> result;
+    for (double fraction : q)
+    {
+      if (values.empty())
+      {
+        result.push_back(std::numeric_limits<double>::quiet_NaN());
+        continue;
+      }
+      const auto at = values.begin() + static_cast<std::ptrdiff_t>(fraction * static_cast<double>(values.size() - 1));
+      std::nth_element(values.begin(), at, values.end());
+      result.push_back(*at);
+    }
+    return result;
+  }
+
+  void
+  SetRange(double lower, double upper, double width)
+  {
+    m_Lower = lower;
+    m_Upper = upper;
+    m_Width = width;
+    m_InverseWidth = width > 0.0 ? 1.0 / width : 0.0;
+  }
+
+  double
+  GetLower() const
+  {
+    return m_Lower;
+  }
+  double
+  GetUpper() const
+  {
+    return m_Upper;
+  }
+  double
+  GetWidth() const
+  {
+    return m_Width;
+  }
+
+  /** Outward speed in [-1, 1] for intensity value (NaN: outside the image,
+   * -1). */
+  double
+  Speed(double value) const
+  {
+    if (!std::isfinite(value))
+    {
+      return -1.0;
+    }
+    const double margin = std::min(value - m_Lower, m_Upper - value) * m_InverseWidth;
+    return std::max(-1.0, std::min(1.0, margin));
+  }
+
+private:
+  double m_Lower{ 0.0 };
+  double m_Upper{ 0.0 };
+  double m_Width{ 1.0 };
+  double m_InverseWidth{ 1.0 };
+};
+
+} // namespace DeformableMeshFilterDetail
+} // namespace itk
+
+#endif

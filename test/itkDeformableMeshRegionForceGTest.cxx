@@ -1,0 +1,200 @@
+/*=========================================================================
+ *
+ *  Copyright NumFOCUS
+ *
+ *  Licensed under the Apache License, Version 2.0 (the "License");
+ *  you may not use this file except in compliance with the License.
+ *  You may obtain a copy of the License at
+ *
+ *         http://www.apache.org/licenses/LICENSE-2.0.txt
+ *
+ *  Unless required by applicable law or agreed to in writing, software
+ *  distributed under the License is distributed on an "AS IS" BASIS,
+ *  WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+ *  See the License for the specific language governing permissions and
+ *  limitations under the License.
+ *
+ *=========================================================================*/
+
+// The region force of DeformableMeshFilter: its intensity model (known
+// answers of the estimate) and a surface that stops on an object's boundary
+// by itself, for a bright object on a dark background and the reverse.
+
+#include "itkDeformableMeshFilter.h"
+#include "itkEllipsoidPhantom.h"
+
+#include "gtest/gtest.h"
+
+#include <cmath>
+#include <vector>
+
+namespace
+{
+using MeshType = itk::Mesh<double, 3>;
+using ImageType = itk::Image<float, 3>;
+using ForceImageType = itk::Image<itk::CovariantVector<float, 3>, 3>;
+using FilterType = itk::DeformableMeshFilter<MeshType, ForceImageType>;
+
+constexpr double Radius = 12.0; // mm, of the ball
+constexpr double Centre = 23.5; // mm, on each axis
+
+/** A 48^3 image (spacing 1) holding a ball of radius Radius: inside and
+ * outside values given. */
+ImageType::Pointer
+MakeBall(float inside, float outside)
+{
+  auto                  image = ImageType::New();
+  ImageType::RegionType region;
+  region.SetSize({ { 48, 48, 48 } });
+  image->SetRegions(region);
+  image->Allocate();
+  for (itk::ImageRegionIteratorWithIndex<ImageType> it(image, region); !it.IsAtEnd(); ++it)
+  {
+    double squared = 0.0;
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      squared += (it.GetIndex()[k] - Centre) * (it.GetIndex()[k] - Centre);
+    }
+    it.Set(squared <= Radius * Radius ? inside : outside);
+  }
+  return image;
+}
+
+ForceImageType::Pointer
+MakeZeroForces(const ImageType * like)
+{
+  auto forces = ForceImageType::New();
+  forces->CopyInformation(like);
+  forces->SetRegions(like->GetLargestPossibleRegion());
+  forces->Allocate();
+  forces->FillBuffer(itk::CovariantVector<float, 3>(0.0f));
+  return forces;
+}
+
+/** Mean and largest |distance to the centre - Radius| of the output. */
+void
+RadialError(const MeshType * mesh, double & mean, double & maximum)
+{
+  mean = 0.0;
+  maximum = 0.0;
+  for (auto it = mesh->GetPoints()->Begin(); it != mesh->GetPoints()->End(); ++it)
+  {
+    double squared = 0.0;
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      squared += (it.Value()[k] - Centre) * (it.Value()[k] - Centre);
+    }
+    const double error = std::abs(std::sqrt(squared) - Radius);
+    mean += error;
+    maximum = std::max(maximum, error);
+  }
+  mean /= static_cast<double>(mesh->GetNumberOfPoints());
+}
+
+/** The region force alone (no external force, full umbrella elasticity and
+ * a little rigidity), from a sphere of radius 5 at the ball's centre. */
+FilterType::Pointer
+MakeFilter(const ImageType * image, unsigned int iterations)
+{
+  MeshType::PointType centre;
+  centre.Fill(Centre);
+  auto filter = FilterType::New();
+  filter->SetInput(itk::MakeSphereMesh<MeshType>(centre, 5.0, 4));
+  filter->SetForceImage(MakeZeroForces(image));
+  filter->SetIntensityImage(image);
+  filter->SetScaleFactor(0.0);
+  filter->SetRegionWeight(0.25);
+  filter->SetElasticity(0.3);
+  filter->SetTangentialElasticity(false);
+  filter->SetRigidity(0.05);
+  filter->SetNumberOfIterations(iterations);
+  return filter;
+}
+
+} // namespace
+
+TEST(DeformableMeshRegionForce, EstimateFromRobustStatistics)
+{
+  // Median 10 and median absolute deviation 1: spread 1.4826.
+  itk::DeformableMeshFilterDetail::RegionForce model;
+  ASSERT_TRUE(model.Estimate({ 8.0, 9.0, 10.0, 11.0, 12.0, 9.5, 10.5 }, 2.5, 9.0, 11.0));
+  EXPECT_NEAR(model.GetLower(), 10.0 - 2.5 * 1.4826, 1e-12);
+  EXPECT_NEAR(model.GetUpper(), 10.0 + 2.5 * 1.4826, 1e-12);
+  EXPECT_NEAR(model.GetWidth(), 1.4826, 1e-12);
+  // Inside the range: inflation, at most 1; on a bound: 0; beyond: deflation.
+  EXPECT_DOUBLE_EQ(model.Speed(10.0), 1.0);
+  EXPECT_NEAR(model.Speed(model.GetLower()), 0.0, 1e-12);
+  EXPECT_NEAR(model.Speed(model.GetUpper() + 0.5 * 1.4826), -0.5, 1e-12);
+  EXPECT_DOUBLE_EQ(model.Speed(-1000.0), -1.0);
+  EXPECT_DOUBLE_EQ(model.Speed(std::nan("")), -1.0); // outside the image
+
+  // No spread (a piecewise constant object): the bound lies halfway to the
+  // image's farther extreme.
+  ASSERT_TRUE(model.Estimate({ 1.0, 1.0, 1.0 }, 2.5, 0.0, 1.0));
+  EXPECT_DOUBLE_EQ(model.GetLower(), 0.5);
+  EXPECT_DOUBLE_EQ(model.GetUpper(), 1.5);
+  EXPECT_DOUBLE_EQ(model.GetWidth(), 0.125);
+  EXPECT_FALSE(model.Estimate({}, 2.5, 0.0, 1.0));
+}
+
+TEST(DeformableMeshRegionForce, BrightBallStopsOnItsBoundaryByItself)
+{
+  const ImageType::Pointer image = MakeBall(100.0f, 20.0f);
+  double                   means[2];
+  unsigned int             k = 0;
+  for (unsigned int iterations : { 500u, 2000u })
+  {
+    const FilterType::Pointer filter = MakeFilter(image, iterations);
+    filter->Update();
+    // Estimated inside the initial sphere: the object's value, the bound
+    // halfway to the background (60).
+    EXPECT_NEAR(filter->GetObjectIntensityLower(), 60.0, 1.0);
+    double maximum;
+    RadialError(filter->GetOutput(), means[k], maximum);
+    EXPECT_LT(means[k], 0.25) << iterations << " iterations";
+    EXPECT_LT(maximum, 0.5) << iterations << " iterations";
+    ++k;
+  }
+  // It stopped: four times as many iterations give the same surface.
+  EXPECT_NEAR(means[0], means[1], 0.02);
+}
+
+TEST(DeformableMeshRegionForce, DarkBallOnBrightBackground)
+{
+  const FilterType::Pointer filter = MakeFilter(MakeBall(-300.0f, 900.0f), 800);
+  filter->Update();
+  EXPECT_NEAR(filter->GetObjectIntensityUpper(), 300.0, 10.0);
+  double mean;
+  double maximum;
+  RadialError(filter->GetOutput(), mean, maximum);
+  EXPECT_LT(mean, 0.25);
+  EXPECT_LT(maximum, 0.5);
+}
+
+TEST(DeformableMeshRegionForce, GivenRangeAndBadParameters)
+{
+  const ImageType::Pointer  image = MakeBall(100.0f, 20.0f);
+  const FilterType::Pointer filter = MakeFilter(image, 600);
+  // A bound at 80 instead of the estimate's 60: the smoothed edge crosses it
+  // 0.67 sigma inside the ball (the normal quantile of 0.75).
+  filter->SetObjectIntensityRange(80.0, 1000.0, 10.0);
+  filter->Update();
+  EXPECT_FALSE(filter->GetEstimateObjectIntensityRange());
+  double mean;
+  double maximum;
+  RadialError(filter->GetOutput(), mean, maximum);
+  EXPECT_LT(mean, 1.0);
+
+  const FilterType::Pointer noImage = MakeFilter(image, 10);
+  noImage->SetIntensityImage(nullptr);
+  EXPECT_THROW(noImage->Update(), itk::ExceptionObject);
+  const FilterType::Pointer badSigma = MakeFilter(image, 10);
+  badSigma->SetRegionSigma(-1.0);
+  EXPECT_THROW(badSigma->Update(), itk::ExceptionObject);
+  const FilterType::Pointer badWeight = MakeFilter(image, 10);
+  badWeight->SetRegionWeight(std::nan(""));
+  EXPECT_THROW(badWeight->Update(), itk::ExceptionObject);
+  const FilterType::Pointer badRange = MakeFilter(image, 10);
+  badRange->SetObjectIntensityRange(5.0, 1.0, 1.0);
+  EXPECT_THROW(badRange->Update(), itk::ExceptionObject);
+}
