@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 # the edmodel Python package and rendering (xvfb for headless tests); qemu-user
 # to test the portable build on an x86-64 processor without AVX.
 packages="cmake make g++ libinsighttoolkit5-dev libgtest-dev libbenchmark-dev
-  libvtk9-dev python3-vtk9 xvfb xauth qemu-user"
+  libvtk9-dev python3-vtk9 xvfb xauth qemu-user mricron-data"
 missing=""
 for p in $packages; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
