@@ -54,9 +54,8 @@ namespace itk
  * the default VectorContainer-based meshes).
  *
  * Subclasses implement Iterate() on the coordinate cache (GetCoordinates(): a
- * flat array of N * PointDimension doubles in physical units, followed by one
- * guard value so that a vector load of a point's coordinates plus one more
- * value stays inside the array) and may override Reset() and HasConverged().
+ * flat array of N * PointDimension doubles in physical units, point after
+ * point) and may override Reset() and HasConverged().
  *
  * \sa BrownianMeshFilter, DeformableMeshFilter
  * \ingroup ExplicitDeformableModel
@@ -138,9 +137,9 @@ protected:
     return false;
   }
 
-  /** The cached coordinates: N * PointDimension doubles, point after point,
-   * then one guard value (0). A subclass that swaps in its own array keeps
-   * that size. */
+  /** The cached coordinates: N * PointDimension doubles, point after point.
+   * A subclass may append values of its own after them (in Reset()) or swap
+   * in an array of its own; only the first N * PointDimension are read. */
   std::vector<double> &
   GetCoordinates()
   {

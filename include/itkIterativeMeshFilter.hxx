@@ -72,7 +72,7 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::CacheInput()
   const SizeValueType   numberOfPoints = points->Size();
 
   m_NumberOfCachedPoints = 0;
-  m_Coordinates.assign(numberOfPoints * PointDimension + 1, 0.0);
+  m_Coordinates.assign(numberOfPoints * PointDimension, 0.0);
   SizeValueType expectedId = 0;
   for (auto it = points->Begin(); it != points->End(); ++it, ++expectedId)
   {
