@@ -21,6 +21,8 @@
 // about 10k, 100k and 1M vertices:
 //   EDM/DeformableMesh          our DeformableMeshFilter, external forces +
 //                               Elasticity + Rigidity, 1 and 2 threads;
+//   EDM/KernelPath              the same step on each kernel path (AVX2+FMA,
+//                               SSE2, portable), 100k vertices, 1 thread;
 //   ITK/DeformableSimplexMesh3D ITK's simplex-mesh model (serial), on the
 //                               simplex mesh dual to a triangle mesh with about
 //                               as many triangles as the others have vertices;
@@ -424,6 +426,48 @@ BM_EDM_DeformableMesh(benchmark::State & state)
   RunDeformableMesh(state, true);
 }
 
+// The same step on each kernel path (0 AVX2+FMA, 1 SSE2, 2 portable), forced
+// for the run; 1 thread. Skipped where the processor lacks the path.
+void
+BM_EDM_KernelPath(benchmark::State & state)
+{
+  using itk::DeformableMeshFilterDetail::KernelPath;
+  const KernelPath paths[] = { KernelPath::AVX2FMA, KernelPath::SSE2, KernelPath::Portable };
+  const KernelPath path = paths[state.range(1)];
+  const KernelPath saved = itk::DeformableMeshFilterDetail::GetKernelPath();
+  if (!itk::DeformableMeshFilterDetail::SetKernelPath(path))
+  {
+    state.SkipWithError("kernel path not available on this processor");
+    return;
+  }
+  state.SetLabel(itk::DeformableMeshFilterDetail::KernelPathName(path));
+  const int64_t      requested = state.range(0);
+  ThreadScope        scope(1);
+  const MeshType *   input = ModelMesh(requested);
+  const auto         vertices = static_cast<int64_t>(input->GetNumberOfPoints());
+  const unsigned int steps = StepsPerUpdate(requested);
+  auto               model = ModelType::New();
+  model->SetInput(input);
+  model->SetForceImage(MeshForceImage());
+  model->SetScaleFactor(0.5);
+  model->SetElasticity(0.3);
+  model->SetRigidity(0.1);
+  model->SetIterateFromZero(false);
+  model->SetNumberOfWorkUnits(1);
+  model->SetNumberOfIterations(1);
+  model->Update();
+  int64_t stepsRun = 0;
+  for (auto _ : state)
+  {
+    model->SetNumberOfIterations(model->GetCurrentIteration() + steps);
+    model->Update();
+    stepsRun += steps;
+  }
+  itk::DeformableMeshFilterDetail::SetKernelPath(saved);
+  state.counters["vertex_it/s"] =
+    benchmark::Counter(static_cast<double>(vertices * stepsRun), benchmark::Counter::kIsRate);
+}
+
 // External force only: the same work as the VTK probe + warp loop.
 void
 BM_EDM_ExternalOnly(benchmark::State & state)
@@ -815,6 +859,12 @@ MeshArguments(benchmark::internal::Benchmark * b, bool threaded)
 
 BENCHMARK(BM_EDM_DeformableMesh)->Apply([](benchmark::internal::Benchmark * b) { MeshArguments(b, true); });
 BENCHMARK(BM_EDM_ExternalOnly)->Apply([](benchmark::internal::Benchmark * b) { MeshArguments(b, true); });
+BENCHMARK(BM_EDM_KernelPath)
+  ->ArgsProduct({ { 100000 }, { 0, 1, 2 } })
+  ->ArgNames({ "vertices", "path" })
+  ->UseRealTime()
+  ->Unit(benchmark::kMillisecond)
+  ->ComputeStatistics("max", Largest);
 BENCHMARK(BM_EDM_OneStepPerUpdate)
   ->Arg(100000)
   ->Arg(1000000)
@@ -933,6 +983,22 @@ PrintSummary()
     PrintRatio("EDM 1 thread / ITK DeformableSimplexMesh3D", ours1, simplex);
     PrintRatio("EDM 1 thread / VTK probe+warp 1 thread", ours1, vtk1);
     PrintRatio("EDM external only / VTK probe+warp, 2 threads", external2, vtk2);
+  }
+  {
+    const double avx2 = Rate("BM_EDM_KernelPath/vertices:100000/path:0/real_time");
+    const double sse2 = Rate("BM_EDM_KernelPath/vertices:100000/path:1/real_time");
+    const double portable = Rate("BM_EDM_KernelPath/vertices:100000/path:2/real_time");
+    if (avx2 + sse2 + portable > 0.0)
+    {
+      std::printf("kernel paths, 100000 vertices, 1 thread (default: %s): AVX2+FMA %.2f M, SSE2 %.2f M, portable "
+                  "%.2f M vertex-iterations/s\n",
+                  itk::DeformableMeshFilterDetail::KernelPathName(itk::DeformableMeshFilterDetail::GetKernelPath()),
+                  avx2 * 1e-6,
+                  sse2 * 1e-6,
+                  portable * 1e-6);
+      PrintRatio("AVX2+FMA / SSE2", avx2, sse2);
+      PrintRatio("SSE2 / portable", sse2, portable);
+    }
   }
   for (const char * size : { "128", "256" })
   {
