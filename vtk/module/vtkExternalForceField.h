@@ -43,7 +43,8 @@
  *
  * Errors (vtkErrorMacro and an empty output): no input array, an array with
  * more than one component, an image that is not three-dimensional, an invalid
- * parameter (negative Sigma, non-positive regularisation), any exception of
+ * parameter (a non-positive regularisation; SetSigma() clamps a negative
+ * Sigma to 0), any exception of
  * the ITK filter (a Sigma beyond the image's largest extent, NaN or infinite
  * intensities), a failed memory allocation. No parameter value crashes.
  *
