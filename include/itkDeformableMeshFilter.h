@@ -407,6 +407,7 @@ private:
   DeformableMeshFilterDetail::IntensitySampler     m_IntensitySampler;
   DeformableMeshFilterDetail::RegionForce          m_RegionForce;
   double                                           m_IntensityQuantiles[2]{}; // 2nd and 98th percentiles
+  double                                           m_IntensityScale{ 1.0 };   // power of two applied before smoothing
   using RegionForceType = DeformableMeshFilterDetail::RegionForce;
   std::vector<float>   m_DisplacementMagnitudes;
   std::vector<float>   m_ExternalForceMagnitudes;

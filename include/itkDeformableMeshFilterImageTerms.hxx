@@ -73,11 +73,46 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareImageTerms()
   if (m_SmoothedIntensity.IsNull() || m_SmoothedIntensitySource != image ||
       m_SmoothedIntensityTime != image->GetMTime() || m_SmoothedIntensitySigma != m_RegionSigma)
   {
+    // Finite values only; intensities whose magnitude is outside 2^+-40 are
+    // scaled by a power of two (exact) so that the smoothing and the
+    // statistics neither overflow nor lose their precision in float.
+    const float * buffer = image->GetBufferPointer();
+    const size_t  count = image->GetBufferedRegion().GetNumberOfPixels();
+    float         largest = 0.0f;
+    for (size_t i = 0; i < count; ++i)
+    {
+      if (!std::isfinite(buffer[i]))
+      {
+        itkExceptionMacro("The intensity image holds a non-finite value (" << buffer[i] << ") at offset " << i
+                                                                           << " of its buffer.");
+      }
+      largest = std::max(largest, std::abs(buffer[i]));
+    }
+    m_IntensityScale = 1.0;
+    if (largest > 0.0f && (largest > std::ldexp(1.0f, 40) || largest < std::ldexp(1.0f, -40)))
+    {
+      m_IntensityScale = std::ldexp(1.0, -std::ilogb(largest));
+    }
+    typename IntensityImageType::ConstPointer source = image;
+    if (m_IntensityScale != 1.0)
+    {
+      auto scaled = IntensityImageType::New();
+      scaled->CopyInformation(image);
+      scaled->SetRegions(image->GetBufferedRegion());
+      scaled->Allocate();
+      // In double: 2^133 (the scale of a denormal maximum) is no float.
+      float * out = scaled->GetBufferPointer();
+      for (size_t i = 0; i < count; ++i)
+      {
+        out[i] = static_cast<float>(static_cast<double>(buffer[i]) * m_IntensityScale);
+      }
+      source = scaled;
+    }
     if (m_RegionSigma > 0.0)
     {
       using SmoothingType = SmoothingRecursiveGaussianImageFilter<IntensityImageType, IntensityImageType>;
       auto smoothing = SmoothingType::New();
-      smoothing->SetInput(image);
+      smoothing->SetInput(source);
       smoothing->SetSigma(m_RegionSigma);
       smoothing->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
       smoothing->Update();
@@ -87,7 +122,7 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareImageTerms()
     else
     {
       m_SmoothedIntensity = IntensityImageType::New();
-      m_SmoothedIntensity->Graft(image);
+      m_SmoothedIntensity->Graft(source);
     }
     m_SmoothedIntensitySource = image;
     m_SmoothedIntensityTime = image->GetMTime();
@@ -115,13 +150,16 @@ DeformableMeshFilter<TMesh, TForceImage>::EstimateImageTermModel()
                                             : "the intensities inside the initial surface are not finite")
                         << "; give the range with SetObjectIntensityRange().");
     }
-    m_ObjectIntensityLower = m_RegionForce.GetLower();
-    m_ObjectIntensityUpper = m_RegionForce.GetUpper();
-    m_ObjectIntensityWidth = m_RegionForce.GetWidth();
+    // Reported in the image's units; the model works on the scaled ones.
+    m_ObjectIntensityLower = m_RegionForce.GetLower() / m_IntensityScale;
+    m_ObjectIntensityUpper = m_RegionForce.GetUpper() / m_IntensityScale;
+    m_ObjectIntensityWidth = m_RegionForce.GetWidth() / m_IntensityScale;
   }
   else
   {
-    m_RegionForce.SetRange(m_ObjectIntensityLower, m_ObjectIntensityUpper, m_ObjectIntensityWidth);
+    m_RegionForce.SetRange(m_ObjectIntensityLower * m_IntensityScale,
+                           m_ObjectIntensityUpper * m_IntensityScale,
+                           m_ObjectIntensityWidth * m_IntensityScale);
   }
 }
 

@@ -65,7 +65,7 @@ constexpr double       Rigidity = 0.05;
 constexpr unsigned int Iterations = 500;
 constexpr double       ConvergenceTolerance = 0.01;
 /** Subdivisions of the octahedron of --init-sphere (4 * 4^n + 2 points). */
-constexpr unsigned int SphereResolution = 3;
+constexpr unsigned int SphereResolution = 4;
 /** Radius of the default initial sphere, as a fraction of the smallest
  * physical extent of the image. */
 constexpr double       SphereRadiusOverExtent = 0.25;

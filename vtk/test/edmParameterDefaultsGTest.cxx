@@ -191,7 +191,7 @@ TEST(ParameterDefaults, AgreeInTheITKAndVTKClassesThePluginAndTheCommandLine)
       static_cast<double>(itkModel->GetTangentialElasticity()),
       static_cast<double>(vtkModel->GetTangentialElasticity()),
       "--no-tangential-elasticity",
-      "tangential" },
+      "full umbrella" },
     { "Rigidity", itkModel->GetRigidity(), vtkModel->GetRigidity(), "--rigidity", "0.05" },
     { "Balloon", itkModel->GetBalloon(), vtkModel->GetBalloon(), "--balloon", nullptr },
     { "MaximumStepLength", itkModel->GetMaximumStepLength(), vtkModel->GetMaximumStepLength(), "--max-step", nullptr },
