@@ -61,6 +61,12 @@ options="-DCMAKE_BUILD_TYPE=Release -DBUILD_SHARED_LIBS=ON -DBUILD_TESTING=OFF -
   -DITK_USE_SYSTEM_GDCM=ON -DITK_USE_SYSTEM_PNG=ON -DITK_USE_SYSTEM_JPEG=ON -DITK_USE_SYSTEM_TIFF=ON
   -DITK_USE_SYSTEM_ZLIB=ON -DITK_USE_SYSTEM_EXPAT=ON -DITK_USE_SYSTEM_EIGEN=ON -DITK_USE_SYSTEM_GOOGLETEST=ON
   -DITK_USE_SYSTEM_DOUBLECONVERSION=OFF"
+case "$version" in
+  6.*)
+    # ITK 6.0b02's CMake links Debian's GDCM through targets it does not
+    # define (ITK::gdcmDICT): its own GDCM, then.
+    options=$(echo "$options" | sed 's/-DITK_USE_SYSTEM_GDCM=ON/-DITK_USE_SYSTEM_GDCM=OFF/') ;;
+esac
 for m in $modules; do
   options="$options -DModule_$m=ON"
 done
@@ -96,11 +102,14 @@ export CCACHE_BASEDIR="$cache"
 export CCACHE_NOHASHDIR=1
 export CCACHE_MAXSIZE="${CCACHE_MAXSIZE:-5G}"
 start=$(date +%s)
-if [ ! -f "$build/CMakeCache.txt" ]; then
+if [ ! -f "$build/.edm-configured" ]; then
   echo "build-itk: configuring ITK $version ($kind) in $build" >&2
+  rm -rf "$build"
+  mkdir -p "$build"
   # shellcheck disable=SC2086
   cmake -S "$src" -B "$build" $options \
     -DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache >&2
+  touch "$build/.edm-configured"
 elif [ -n "$module_dir" ]; then
   # The module's sources may be another checkout than last time, with older
   # time stamps than the objects: rebuild the module, configured afresh.

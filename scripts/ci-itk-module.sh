@@ -20,14 +20,6 @@ repo=$(pwd)
 jobs=${EDM_CI_JOBS:-2}
 [ $# -gt 0 ] || set -- 5.2.1 5.4.7
 
-for p in libbenchmark-dev; do
-  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
-    export DEBIAN_FRONTEND=noninteractive
-    apt-get update -qq
-    apt-get install -y -qq --no-install-recommends "$p"
-  fi
-done
-
 # run LOG COMMAND...: runs COMMAND with its output shown and kept in LOG;
 # fails when COMMAND fails.
 run() {
@@ -46,12 +38,13 @@ for version in "$@"; do
   itk=$(scripts/build-itk.sh "$version" | tail -n 1)
   itk_built=$(date +%s)
 
-  # 1. ITKModuleExternal. The VTK module is the first two stages' (this
-  # stage runs after the ParaView one, which removes the plain VTK).
+  # 1. ITKModuleExternal. The VTK module and the benchmarks are the first
+  # stages' (this one runs after the ParaView stage, which removes the plain
+  # VTK; both build through ITKModuleExternal too when asked).
   build="build-itk-$version"
   mkdir -p "$build"
   run "$build/configure.log" cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DITK_DIR="$itk" \
-    -DITK_USE_KWSTYLE=OFF -DITK_USE_CLANG_FORMAT=OFF -DEDM_USE_VTK=OFF
+    -DITK_USE_KWSTYLE=OFF -DITK_USE_CLANG_FORMAT=OFF -DEDM_USE_VTK=OFF -DEDM_BUILD_BENCHMARKS=OFF
   grep -q "building through ITKModuleExternal" "$build/configure.log" || {
     echo "ci-itk-module: ITK $version was not taken through ITKModuleExternal" >&2; exit 1; }
   run "$build/build.log" cmake --build "$build" -j"$jobs"
