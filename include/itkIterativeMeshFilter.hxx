@@ -22,6 +22,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <new>
 
 namespace itk
@@ -127,9 +128,10 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::ThrowNonFiniteCoordinate(SizeValue
   {
     ++i;
   }
-  itkExceptionMacro("Point #" << i / PointDimension << " has a non-finite coordinate (" << m_Coordinates[std::min(i, n)]
-                              << ") after iteration " << m_CurrentIteration << " (this update ran iterations "
-                              << firstIteration + 1 << " to " << m_CurrentIteration
+  const double value = i < n ? m_Coordinates[i] : std::numeric_limits<double>::quiet_NaN();
+  itkExceptionMacro("Point #" << i / PointDimension << " has a non-finite coordinate (" << value << ") after iteration "
+                              << m_CurrentIteration << " (this update ran iterations " << firstIteration + 1 << " to "
+                              << m_CurrentIteration
                               << "): the step diverged. Likely causes: a force image holding NaN or infinite "
                                  "values, or steps so large (scale factor, balloon) that the coordinates overflowed.");
 }
