@@ -208,13 +208,13 @@ SampleForces(const ForceSampler<TPixel> & sampler,
     // then continuous indices, inside test, weights and the byte offsets of
     // the eight corners (clamped at the border) in the lanes of registers;
     // the corners are then loaded and blended vertex by vertex.
-    const char *            bytes = reinterpret_cast<const char *>(sampler.buffer);
-    const __m128i           lastBytes = _mm_set1_epi32(static_cast<int32_t>(sampler.lastPixel * sizeof(TPixel)));
-    alignas(32) int32_t     corners[8][ChunkSize];
-    alignas(32) double      weights[3][ChunkSize];
-    uint32_t                insideBits = 0;
-    uint32_t                paddedBits = 0;
-    double                  tail[12];
+    const char *        bytes = reinterpret_cast<const char *>(sampler.buffer);
+    const __m128i       lastBytes = _mm_set1_epi32(static_cast<int32_t>(sampler.lastPixel * sizeof(TPixel)));
+    alignas(32) int32_t corners[8][ChunkSize];
+    alignas(32) double  weights[3][ChunkSize];
+    uint32_t            insideBits = 0;
+    uint32_t            paddedBits = 0;
+    double              tail[12];
     for (SizeValueType j = begin; j < end; j += 4)
     {
       // The last group of a chunk may be short: its coordinates are copied,
@@ -362,8 +362,7 @@ GeneralGeometry(const MeshTables & mesh, const double * x, SizeValueType i, Vec4
   u = Vec4{ s[0] * inverseCount, s[1] * inverseCount, s[2] * inverseCount, 0.0 };
 
   const auto rank = static_cast<SizeValueType>(
-    std::lower_bound(
-      mesh.generalVertices, mesh.generalVertices + mesh.numberOfGeneral, static_cast<uint32_t>(i)) -
+    std::lower_bound(mesh.generalVertices, mesh.generalVertices + mesh.numberOfGeneral, static_cast<uint32_t>(i)) -
     mesh.generalVertices);
   double normal[3] = { 0.0, 0.0, 0.0 };
   for (uint32_t k = mesh.generalPairOffsets[rank]; k < mesh.generalPairOffsets[rank + 1]; ++k)
@@ -524,28 +523,28 @@ StepBlock(const ForceSampler<TPixel> & forceSampler,
 {
   // Everything the loop reads, in locals: the compiler cannot keep members in
   // registers across the stores to the output arrays.
-  const double                elasticity = terms.elasticity;
-  const double                rigidity = terms.rigidity;
-  const bool                  useElasticity = elasticity > 0.0;
-  const bool                  tangential = useElasticity && terms.tangential;
-  const double                scaleFactor = terms.scaleFactor;
-  const double                balloon = terms.balloon;
-  const double                maximumStep = terms.maximumStep;
-  const double                orientationSign = terms.orientationSign;
-  const uint8_t *             order = mesh.valenceOrder;
-  const ForceSampler<TPixel>  sampler = forceSampler;
-  const SamplerVectors        samplerVectors(sampler);
-  const double *              x = arrays.coordinates;
-  double *                    next = arrays.next;
-  const float *               umbrellaField = arrays.umbrella;
-  const float *               normalField = arrays.normals;
-  const uint32_t *            offsets = mesh.neighbourOffsets;
-  const uint32_t *            neighbours = mesh.neighbours;
-  uint8_t *                   balloonReleased = arrays.balloonReleased;
-  const float *               normalSpeeds = arrays.normalSpeeds;
-  float *                     displacementMagnitudes = arrays.displacementMagnitudes;
-  float *                     externalMagnitudes = arrays.externalMagnitudes;
-  float *                     internalMagnitudes = arrays.internalMagnitudes;
+  const double               elasticity = terms.elasticity;
+  const double               rigidity = terms.rigidity;
+  const bool                 useElasticity = elasticity > 0.0;
+  const bool                 tangential = useElasticity && terms.tangential;
+  const double               scaleFactor = terms.scaleFactor;
+  const double               balloon = terms.balloon;
+  const double               maximumStep = terms.maximumStep;
+  const double               orientationSign = terms.orientationSign;
+  const uint8_t *            order = mesh.valenceOrder;
+  const ForceSampler<TPixel> sampler = forceSampler;
+  const SamplerVectors       samplerVectors(sampler);
+  const double *             x = arrays.coordinates;
+  double *                   next = arrays.next;
+  const float *              umbrellaField = arrays.umbrella;
+  const float *              normalField = arrays.normals;
+  const uint32_t *           offsets = mesh.neighbourOffsets;
+  const uint32_t *           neighbours = mesh.neighbours;
+  uint8_t *                  balloonReleased = arrays.balloonReleased;
+  const float *              normalSpeeds = arrays.normalSpeeds;
+  float *                    displacementMagnitudes = arrays.displacementMagnitudes;
+  float *                    externalMagnitudes = arrays.externalMagnitudes;
+  float *                    internalMagnitudes = arrays.internalMagnitudes;
 
   // The external forces of a chunk first, then the rest: two short loop
   // bodies whose long dependency chains (index, voxel loads, interpolation;

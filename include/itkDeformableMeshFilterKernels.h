@@ -170,8 +170,8 @@ RunStepBlock(KernelPath                   path,
 #endif
 #if EDM_KERNELS_SSE2
           case KernelPath::SSE2:
-            largest =
-              SSE2::StepBlock<TPixel, UseRigidity, UseNormal, Ordered>(sampler, mesh, terms, arrays, begin, end, diagnose);
+            largest = SSE2::StepBlock<TPixel, UseRigidity, UseNormal, Ordered>(
+              sampler, mesh, terms, arrays, begin, end, diagnose);
             return;
 #endif
           default:

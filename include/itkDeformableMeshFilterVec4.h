@@ -167,7 +167,8 @@ operator-(const Vec4 & a, const Vec4 & b)
 {
   return Vec4(_mm_sub_pd(a.lo, b.lo), _mm_sub_pd(a.hi, b.hi));
 }
-EDM_ALWAYS_INLINE Vec4 operator*(const Vec4 & a, const Vec4 & b)
+EDM_ALWAYS_INLINE Vec4
+operator*(const Vec4 & a, const Vec4 & b)
 {
   return Vec4(_mm_mul_pd(a.lo, b.lo), _mm_mul_pd(a.hi, b.hi));
 }
@@ -257,7 +258,8 @@ operator-(const Vec4 & a, const Vec4 & b)
 {
   return Vec4{ { a.v[0] - b.v[0], a.v[1] - b.v[1], a.v[2] - b.v[2], a.v[3] - b.v[3] } };
 }
-inline Vec4 operator*(const Vec4 & a, const Vec4 & b)
+inline Vec4
+operator*(const Vec4 & a, const Vec4 & b)
 {
   return Vec4{ { a.v[0] * b.v[0], a.v[1] * b.v[1], a.v[2] * b.v[2], a.v[3] * b.v[3] } };
 }

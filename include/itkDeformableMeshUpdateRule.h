@@ -68,11 +68,11 @@ struct DeformableMeshUpdateRule
     double     normalSpeed{ 0.0 };  // v: outward speed of the image terms, mm per iteration
   };
 
-  double scaleFactor{ 1.0 };      // s, mm per unit of force
-  double elasticity{ 0.0 };       // a, after the a + 2b <= 1 scaling
-  double rigidity{ 0.0 };         // b, after the a + 2b <= 1 scaling
-  bool   tangential{ true };      // E keeps its tangent part only
-  double balloon{ 0.0 };          // beta, mm per iteration
+  double scaleFactor{ 1.0 };       // s, mm per unit of force
+  double elasticity{ 0.0 };        // a, after the a + 2b <= 1 scaling
+  double rigidity{ 0.0 };          // b, after the a + 2b <= 1 scaling
+  bool   tangential{ true };       // E keeps its tangent part only
+  double balloon{ 0.0 };           // beta, mm per iteration
   double maximumStepLength{ 0.0 }; // mm; 0: no bound
 
   /** The rule of a filter's parameters: Elasticity and Rigidity scaled down
@@ -125,7 +125,7 @@ struct DeformableMeshUpdateRule
     }
     speed += v.normalSpeed;
 
-    VectorType delta = external + elasticity * elastic + rigidity * bending + speed * v.normal;
+    VectorType   delta = external + elasticity * elastic + rigidity * bending + speed * v.normal;
     const double length = delta.GetNorm();
     if (maximumStepLength > 0.0 && length > maximumStepLength)
     {

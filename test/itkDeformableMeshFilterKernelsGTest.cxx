@@ -40,8 +40,7 @@
 
 namespace
 {
-using MeshType =
-  itk::Mesh<double, 3, itk::DefaultStaticMeshTraits<double, 3, 3, double, double, double>>;
+using MeshType = itk::Mesh<double, 3, itk::DefaultStaticMeshTraits<double, 3, 3, double, double, double>>;
 using ForceImageType = itk::Image<itk::Vector<float, 3>, 3>;
 using FilterType = itk::DeformableMeshFilter<MeshType, ForceImageType>;
 using RuleType = itk::DeformableMeshUpdateRule;
@@ -107,9 +106,9 @@ MeshType::Pointer
 MakeIrregularMesh()
 {
   using SourceType = itk::RegularSphereMeshSource<MeshType>;
-  auto                    source = SourceType::New();
-  SourceType::VectorType  scale;
-  SourceType::PointType   center;
+  auto                   source = SourceType::New();
+  SourceType::VectorType scale;
+  SourceType::PointType  center;
   scale.Fill(9.0);
   center.Fill(16.0);
   source->SetCenter(center);
@@ -145,7 +144,7 @@ MakeIrregularMesh()
     }
   }
   // Disk of 12 triangles around (4, 4, 28), slightly curved.
-  const auto hub = AddPoint(mesh, 4.0, 4.0, 28.0);
+  const auto                             hub = AddPoint(mesh, 4.0, 4.0, 28.0);
   std::vector<MeshType::PointIdentifier> rim;
   for (unsigned int k = 0; k < 12; ++k)
   {
@@ -369,14 +368,14 @@ private:
   }
 
   using InterpolatorType = itk::VectorLinearInterpolateImageFunction<ForceImageType, double>;
-  const ForceImageType *                                  m_Forces;
-  RuleType                                                m_Rule;
-  std::vector<VectorType>                                 m_X;
-  std::vector<std::set<MeshType::PointIdentifier>>        m_Neighbours;
+  const ForceImageType *                                             m_Forces;
+  RuleType                                                           m_Rule;
+  std::vector<VectorType>                                            m_X;
+  std::vector<std::set<MeshType::PointIdentifier>>                   m_Neighbours;
   std::vector<std::vector<std::array<MeshType::PointIdentifier, 2>>> m_Triangles;
-  std::vector<bool>                                       m_Released;
-  double                                                  m_Sign{ 1.0 };
-  InterpolatorType::Pointer                               m_Interpolator{ InterpolatorType::New() };
+  std::vector<bool>                                                  m_Released;
+  double                                                             m_Sign{ 1.0 };
+  InterpolatorType::Pointer                                          m_Interpolator{ InterpolatorType::New() };
 };
 
 struct TermSet
@@ -479,10 +478,10 @@ namespace
 MeshType::Pointer
 MakeOctahedronMesh()
 {
-  constexpr int n = 16;
-  auto          mesh = MeshType::New();
+  constexpr int                                           n = 16;
+  auto                                                    mesh = MeshType::New();
   std::map<std::array<int, 3>, MeshType::PointIdentifier> ids;
-  auto vertex = [&](int i, int j, int k) {
+  auto                                                    vertex = [&](int i, int j, int k) {
     const std::array<int, 3> key{ i, j, k };
     const auto               found = ids.find(key);
     if (found != ids.end())
@@ -552,9 +551,11 @@ MakeExactForceImage()
   image->Allocate();
   for (itk::ImageRegionIteratorWithIndex<ForceImageType> it(image, image->GetBufferedRegion()); !it.IsAtEnd(); ++it)
   {
-    const auto index = it.GetIndex();
-    const int  e[3] = { static_cast<int>(index[0]) - 16, static_cast<int>(index[1]) - 16, static_cast<int>(index[2]) - 16 };
-    const int  q = std::max(-512, std::min(512, 100 - (e[0] * e[0] + e[1] * e[1] + e[2] * e[2])));
+    const auto                index = it.GetIndex();
+    const int                 e[3] = { static_cast<int>(index[0]) - 16,
+                                       static_cast<int>(index[1]) - 16,
+                                       static_cast<int>(index[2]) - 16 };
+    const int                 q = std::max(-512, std::min(512, 100 - (e[0] * e[0] + e[1] * e[1] + e[2] * e[2])));
     ForceImageType::PixelType f;
     for (unsigned int d = 0; d < 3; ++d)
     {
@@ -628,7 +629,8 @@ TEST(DeformableMeshFilterKernels, ThreeHundredStepsGiveTheBitsOfTheStepBeforeThe
         EXPECT_LT((x[i] - fused[i]).GetNorm(), 1e-6) << terms.name << ", vertex " << i;
       }
 #else
-      EXPECT_EQ(HashOf(x), unfusedBits[c]) << terms.name << ", " << itk::DeformableMeshFilterDetail::KernelPathName(path);
+      EXPECT_EQ(HashOf(x), unfusedBits[c])
+        << terms.name << ", " << itk::DeformableMeshFilterDetail::KernelPathName(path);
 #endif
     }
   }

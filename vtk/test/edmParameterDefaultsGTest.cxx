@@ -67,7 +67,7 @@ RunProgram(const std::string & command)
   std::string output;
   if (FILE * pipe = popen(command.c_str(), "r"))
   {
-    char buffer[4096];
+    char   buffer[4096];
     size_t n;
     while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0)
     {
@@ -144,9 +144,9 @@ SameNumber(const std::string & text, double value)
 }
 
 void
-CheckLayers(const Parameter * parameters,
-            std::size_t       count,
-            const char *      proxy,
+CheckLayers(const Parameter *   parameters,
+            std::size_t         count,
+            const char *        proxy,
             const std::string & xml,
             const std::string & help)
 {
@@ -181,57 +181,57 @@ TEST(ParameterDefaults, AgreeInTheITKAndVTKClassesThePluginAndTheCommandLine)
   const std::string help = RunProgram(std::string("\"") + EDM_EDMODEL_PROGRAM + "\" segment --help 2>&1");
   ASSERT_NE(help.find("--scale"), std::string::npos) << help;
 
-  const auto itkModel = itk::DeformableMeshFilter<MeshType, ForceImageType>::New();
+  const auto                itkModel = itk::DeformableMeshFilter<MeshType, ForceImageType>::New();
   vtkNew<vtkDeformableMesh> vtkModel;
-  const Parameter model[] = {
-    // name, ITK, VTK, edmodel option, edmodel's own default (nullptr: ITK's)
+  const Parameter           model[] = {
+              // name, ITK, VTK, edmodel option, edmodel's own default (nullptr: ITK's)
     { "ScaleFactor", itkModel->GetScaleFactor(), vtkModel->GetScaleFactor(), "--scale", "0.5 x sigma" },
     { "Elasticity", itkModel->GetElasticity(), vtkModel->GetElasticity(), "--elasticity", "0.3" },
     { "TangentialElasticity",
-      static_cast<double>(itkModel->GetTangentialElasticity()),
-      static_cast<double>(vtkModel->GetTangentialElasticity()),
-      "--no-tangential-elasticity",
-      "full umbrella" },
+                static_cast<double>(itkModel->GetTangentialElasticity()),
+                static_cast<double>(vtkModel->GetTangentialElasticity()),
+                "--no-tangential-elasticity",
+                "full umbrella" },
     { "Rigidity", itkModel->GetRigidity(), vtkModel->GetRigidity(), "--rigidity", "0.05" },
     { "Balloon", itkModel->GetBalloon(), vtkModel->GetBalloon(), "--balloon", nullptr },
     { "MaximumStepLength", itkModel->GetMaximumStepLength(), vtkModel->GetMaximumStepLength(), "--max-step", nullptr },
     { "ConvergenceTolerance",
-      itkModel->GetConvergenceTolerance(),
-      vtkModel->GetConvergenceTolerance(),
-      "--tolerance",
-      "0.01" },
+                itkModel->GetConvergenceTolerance(),
+                vtkModel->GetConvergenceTolerance(),
+                "--tolerance",
+                "0.01" },
     { "ConvergenceWindow",
-      static_cast<double>(itkModel->GetConvergenceWindow()),
-      static_cast<double>(vtkModel->GetConvergenceWindow()),
-      "--window",
-      nullptr },
+                static_cast<double>(itkModel->GetConvergenceWindow()),
+                static_cast<double>(vtkModel->GetConvergenceWindow()),
+                "--window",
+                nullptr },
   };
   CheckLayers(model, sizeof(model) / sizeof(model[0]), "EDMDeformableMesh", xml, help);
 
-  const auto itkForces = itk::ExternalForceImageFilter<ImageType, ForceImageType>::New();
+  const auto                    itkForces = itk::ExternalForceImageFilter<ImageType, ForceImageType>::New();
   vtkNew<vtkExternalForceField> vtkForces;
-  const Parameter forces[] = {
-    { "Sigma", itkForces->GetSigma(), vtkForces->GetSigma(), "--sigma", "1 x the smallest voxel spacing" },
-    { "NormalizeForces",
-      static_cast<double>(itkForces->GetNormalizeForces()),
-      static_cast<double>(vtkForces->GetNormalizeForces()),
-      "--no-normalize-forces",
-      "normalised" },
-    { "UseGradientVectorFlow",
-      static_cast<double>(itkForces->GetUseGradientVectorFlow()),
-      static_cast<double>(vtkForces->GetUseGradientVectorFlow()),
-      "--gvf",
-      "off" },
-    { "GradientVectorFlowRegularization",
-      itkForces->GetGradientVectorFlowRegularization(),
-      vtkForces->GetGradientVectorFlowRegularization(),
-      "--gvf-mu",
-      nullptr },
-    { "GradientVectorFlowIterations",
-      static_cast<double>(itkForces->GetGradientVectorFlowIterations()),
-      static_cast<double>(vtkForces->GetGradientVectorFlowIterations()),
-      "--gvf-iterations",
-      nullptr },
+  const Parameter               forces[] = {
+                  { "Sigma", itkForces->GetSigma(), vtkForces->GetSigma(), "--sigma", "1 x the smallest voxel spacing" },
+                  { "NormalizeForces",
+                    static_cast<double>(itkForces->GetNormalizeForces()),
+                    static_cast<double>(vtkForces->GetNormalizeForces()),
+                    "--no-normalize-forces",
+                    "normalised" },
+                  { "UseGradientVectorFlow",
+                    static_cast<double>(itkForces->GetUseGradientVectorFlow()),
+                    static_cast<double>(vtkForces->GetUseGradientVectorFlow()),
+                    "--gvf",
+                    "off" },
+                  { "GradientVectorFlowRegularization",
+                    itkForces->GetGradientVectorFlowRegularization(),
+                    vtkForces->GetGradientVectorFlowRegularization(),
+                    "--gvf-mu",
+                    nullptr },
+                  { "GradientVectorFlowIterations",
+                    static_cast<double>(itkForces->GetGradientVectorFlowIterations()),
+                    static_cast<double>(vtkForces->GetGradientVectorFlowIterations()),
+                    "--gvf-iterations",
+                    nullptr },
   };
   CheckLayers(forces, sizeof(forces) / sizeof(forces[0]), "EDMForceField", xml, help);
 }
