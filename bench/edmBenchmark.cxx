@@ -387,10 +387,9 @@ private:
 // ---------------------------------------------------------------------------
 // Our filter: external forces + Elasticity + Rigidity, tangential elasticity.
 void
-RunDeformableMesh(benchmark::State & state, bool internalForces)
+RunDeformableMesh(benchmark::State & state, bool internalForces, unsigned int threads)
 {
   const int64_t      requested = state.range(0);
-  const auto         threads = static_cast<unsigned int>(state.range(1));
   ThreadScope        scope(threads);
   const MeshType *   input = ModelMesh(requested);
   const auto         vertices = static_cast<int64_t>(input->GetNumberOfPoints());
@@ -417,13 +416,15 @@ RunDeformableMesh(benchmark::State & state, bool internalForces)
   state.counters["vertices"] = static_cast<double>(vertices);
   state.counters["vertex_it/s"] =
     benchmark::Counter(static_cast<double>(vertices * stepsRun), benchmark::Counter::kIsRate);
-  state.SetLabel("steps/update=" + std::to_string(steps));
+  state.SetLabel(std::string(itk::DeformableMeshFilterDetail::KernelPathName(
+                   itk::DeformableMeshFilterDetail::GetKernelPath())) +
+                 ", steps/update=" + std::to_string(steps));
 }
 
 void
 BM_EDM_DeformableMesh(benchmark::State & state)
 {
-  RunDeformableMesh(state, true);
+  RunDeformableMesh(state, true, static_cast<unsigned int>(state.range(1)));
 }
 
 // The same step on each kernel path (0 AVX2+FMA, 1 SSE2, 2 portable), forced
@@ -440,39 +441,15 @@ BM_EDM_KernelPath(benchmark::State & state)
     state.SkipWithError("kernel path not available on this processor");
     return;
   }
-  state.SetLabel(itk::DeformableMeshFilterDetail::KernelPathName(path));
-  const int64_t      requested = state.range(0);
-  ThreadScope        scope(1);
-  const MeshType *   input = ModelMesh(requested);
-  const auto         vertices = static_cast<int64_t>(input->GetNumberOfPoints());
-  const unsigned int steps = StepsPerUpdate(requested);
-  auto               model = ModelType::New();
-  model->SetInput(input);
-  model->SetForceImage(MeshForceImage());
-  model->SetScaleFactor(0.5);
-  model->SetElasticity(0.3);
-  model->SetRigidity(0.1);
-  model->SetIterateFromZero(false);
-  model->SetNumberOfWorkUnits(1);
-  model->SetNumberOfIterations(1);
-  model->Update();
-  int64_t stepsRun = 0;
-  for (auto _ : state)
-  {
-    model->SetNumberOfIterations(model->GetCurrentIteration() + steps);
-    model->Update();
-    stepsRun += steps;
-  }
+  RunDeformableMesh(state, true, 1);
   itk::DeformableMeshFilterDetail::SetKernelPath(saved);
-  state.counters["vertex_it/s"] =
-    benchmark::Counter(static_cast<double>(vertices * stepsRun), benchmark::Counter::kIsRate);
 }
 
 // External force only: the same work as the VTK probe + warp loop.
 void
 BM_EDM_ExternalOnly(benchmark::State & state)
 {
-  RunDeformableMesh(state, false);
+  RunDeformableMesh(state, false, static_cast<unsigned int>(state.range(1)));
 }
 
 // ---------------------------------------------------------------------------
