@@ -79,7 +79,8 @@ void
 DeformableMeshFilter<TMesh, TForceImage>::GenerateData()
 {
   this->PrepareForceSampler();
-  m_ForceImageCheck.Verify(this->GetForceImage(), m_ScaleFactor, m_Balloon, m_MaximumStepLength);
+  m_ForceImageCheck.Verify(
+    this->GetForceImage(), m_ScaleFactor, std::abs(m_Balloon) + m_RegionWeight, m_MaximumStepLength);
   if (this->UsesImageTerms())
   {
     this->PrepareImageTerms();

@@ -190,12 +190,12 @@ public:
 
   /** Sets the range from the samples' median m and robust spread s
    * (1.4826 times their median absolute deviation): [m - h, m + h] with
-   * h = max(k s, (m - low) / 2, (high - m) / 2), k the tolerance and low,
-   * high the image's 2nd and 98th percentiles. The second and third terms
-   * make a piecewise constant image (no spread inside) place the bound
-   * halfway between the object's intensity and the image's other extreme,
-   * which is where the smoothed image crosses the object's edge. Width:
-   * max(s, h / 4). Returns false when there is no sample. */
+   * h = k s, k the tolerance. When k s is below a fifth of the image's range
+   * (high - low, its 98th and 2nd percentiles), the object is piecewise
+   * constant (a binary or noiseless image) and h = max(m - low, high - m) / 2
+   * instead: the bound then lies halfway between the object's intensity and
+   * the image's other extreme, where the smoothed image crosses the object's
+   * edge. Width: max(s / 2, h / 8). Returns false when there is no sample. */
   bool
   Estimate(std::vector<double> samples, double tolerance, double low, double high)
   {
@@ -214,8 +214,12 @@ public:
       value = std::abs(value - centre);
     }
     const double spread = 1.4826 * median(samples);
-    const double halfWidth = std::max({ tolerance * spread, 0.5 * (centre - low), 0.5 * (high - centre) });
-    SetRange(centre - halfWidth, centre + halfWidth, std::max(spread, 0.25 * halfWidth));
+    double halfWidth = tolerance * spread;
+    if (!(halfWidth >= 0.2 * (high - low)))
+    {
+      halfWidth = std::max(0.5 * (centre - low), 0.5 * (high - centre));
+    }
+    SetRange(centre - halfWidth, centre + halfWidth, std::max(0.5 * spread, 0.125 * halfWidth));
     return std::isfinite(m_Lower) && std::isfinite(m_Upper) && m_Width > 0.0;
   }
 

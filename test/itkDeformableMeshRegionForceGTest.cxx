@@ -120,20 +120,23 @@ TEST(DeformableMeshRegionForce, EstimateFromRobustStatistics)
   ASSERT_TRUE(model.Estimate({ 8.0, 9.0, 10.0, 11.0, 12.0, 9.5, 10.5 }, 2.5, 9.0, 11.0));
   EXPECT_NEAR(model.GetLower(), 10.0 - 2.5 * 1.4826, 1e-12);
   EXPECT_NEAR(model.GetUpper(), 10.0 + 2.5 * 1.4826, 1e-12);
-  EXPECT_NEAR(model.GetWidth(), 1.4826, 1e-12);
+  EXPECT_NEAR(model.GetWidth(), 0.5 * 1.4826, 1e-12);
   // Inside the range: inflation, at most 1; on a bound: 0; beyond: deflation.
   EXPECT_DOUBLE_EQ(model.Speed(10.0), 1.0);
   EXPECT_NEAR(model.Speed(model.GetLower()), 0.0, 1e-12);
-  EXPECT_NEAR(model.Speed(model.GetUpper() + 0.5 * 1.4826), -0.5, 1e-12);
+  EXPECT_NEAR(model.Speed(model.GetUpper() + 0.25 * 1.4826), -0.5, 1e-12);
   EXPECT_DOUBLE_EQ(model.Speed(-1000.0), -1.0);
   EXPECT_DOUBLE_EQ(model.Speed(std::nan("")), -1.0); // outside the image
 
   // No spread (a piecewise constant object): the bound lies halfway to the
   // image's farther extreme.
+  // A spread below a fifth of the image's range counts as none.
+  ASSERT_TRUE(model.Estimate({ 9.9, 10.0, 10.1 }, 2.5, 0.0, 10.0));
+  EXPECT_DOUBLE_EQ(model.GetLower(), 5.0);
   ASSERT_TRUE(model.Estimate({ 1.0, 1.0, 1.0 }, 2.5, 0.0, 1.0));
   EXPECT_DOUBLE_EQ(model.GetLower(), 0.5);
   EXPECT_DOUBLE_EQ(model.GetUpper(), 1.5);
-  EXPECT_DOUBLE_EQ(model.GetWidth(), 0.125);
+  EXPECT_DOUBLE_EQ(model.GetWidth(), 0.0625);
   EXPECT_FALSE(model.Estimate({}, 2.5, 0.0, 1.0));
 }
 
