@@ -13,7 +13,7 @@ edm_help(segment_help segment --help)
 edm_help(demo_help demo --help)
 edm_help(version --version)
 
-if(NOT "${version}" MATCHES "^edmodel [0-9]+\\.[0-9]+\\.[0-9]+ .*ITK 5")
+if(NOT "${version}" MATCHES "^edmodel [0-9]+\\.[0-9]+\\.[0-9]+ .*ITK [5-9]")
   message(FATAL_ERROR "--version: '${version}'")
 endif()
 foreach(word segment demo --threads --quiet --version)
