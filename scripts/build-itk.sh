@@ -77,6 +77,12 @@ else
   kind=external
 fi
 key="$version-$kind-$(printf '%s %s' "$options" "$(g++ -dumpfullversion)" | sha256sum | cut -c1-12)"
+# VNL's SSE2 rounding option is defined after ITK reads it for its compiler
+# flags: a first configuration compiles without -msse2 and any later one (make
+# re-runs CMake when the module's files change) with it, recompiling all of
+# ITK. Set to its x86-64 default from the start, the flags never change (not
+# part of the key: the configured tree is the same).
+options="$options -DVNL_CONFIG_ENABLE_SSE2_ROUNDING=ON"
 
 # One source tree per version, shared by both kinds (same relative paths
 # from both build trees: ccache hits across them).
