@@ -329,7 +329,7 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                 "weight of the region force: largest inflation (inside the object's intensity range) or deflation "
                 "(outside it) per iteration, physical units (mm); stops by itself on the object's boundary; 0 turns "
                 "it off",
-                FormatNumber(defaults::RegionWeight),
+                FormatNumber(defaults::RegionWeightInVoxels) + " x the smallest voxel spacing",
                 [&o](const std::string & s) {
                   o.regionWeight = ParseDouble("--region", s);
                   RequireAtLeast("--region", o.regionWeight, 0.0);
@@ -352,7 +352,7 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                 "--region-sigma",
                 "MM",
                 "Gaussian smoothing of the image for the region force, physical units (mm)",
-                FormatNumber(defaults::RegionSigma),
+                FormatNumber(defaults::RegionSigmaInVoxels) + " x the smallest voxel spacing",
                 [&o](const std::string & s) {
                   o.regionSigma = ParseDouble("--region-sigma", s);
                   RequireAtLeast("--region-sigma", o.regionSigma, 0.0);

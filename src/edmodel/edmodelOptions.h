@@ -73,9 +73,7 @@ constexpr unsigned int SnapshotEvery = 10;
 /** Region force: largest inflation or deflation per iteration, as a fraction
  * of the smallest voxel spacing, and the smoothing of its image in voxels. */
 constexpr double RegionWeightInVoxels = 0.25;
-constexpr double RegionWeight = 0.25; // mm on a 1 mm grid, for the help text
 constexpr double RegionSigmaInVoxels = 1.0;
-constexpr double RegionSigma = 1.0;
 /** Mean edge length the coarse-to-fine refinement aims at, in voxels of the
  * smallest spacing, and the largest number of points it creates. */
 constexpr double       EdgeLengthInVoxels = 1.0;

@@ -56,6 +56,12 @@ public:
   vtkMTimeType            ImageTime = 0;
   const vtkDataArray *    Array = nullptr;
   vtkMTimeType            ArrayTime = 0;
+  // The region force's intensities (second array of port 1).
+  FilterType::IntensityImageType::Pointer IntensityImage;
+  const vtkImageData *                    IntensitySource = nullptr;
+  vtkMTimeType                            IntensitySourceTime = 0;
+  const vtkDataArray *                    IntensityArray = nullptr;
+  vtkMTimeType                            IntensityArrayTime = 0;
 };
 
 //------------------------------------------------------------------------------
@@ -75,7 +81,11 @@ vtkDeformableMesh::vtkDeformableMesh()
   this->MaximumStepLength = filter->GetMaximumStepLength();
   this->ConvergenceTolerance = filter->GetConvergenceTolerance();
   this->ConvergenceWindow = static_cast<int>(filter->GetConvergenceWindow());
+  this->RegionWeight = filter->GetRegionWeight();
+  this->RegionSigma = filter->GetRegionSigma();
+  this->IntensityTolerance = filter->GetIntensityTolerance();
   this->SetInputArrayToProcess(0, 1, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::VECTORS);
+  this->SetInputArrayToProcess(1, 1, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
 }
 
 //------------------------------------------------------------------------------
@@ -185,6 +195,49 @@ vtkDeformableMesh::PrepareFilter(vtkInformationVector ** inputVector)
   }
 
   auto * filter = internals.Filter.GetPointer();
+  if (this->RegionWeight > 0.0)
+  {
+    vtkDataArray * intensities = this->GetInputArrayToProcess(1, inputVector);
+    if (intensities == nullptr || intensities->GetNumberOfComponents() != 1 ||
+        intensities->GetNumberOfTuples() != image->GetNumberOfPoints())
+    {
+      vtkErrorMacro("RegionWeight is " << this->RegionWeight
+                                       << " but the image on input port 1 has no one-component point array of "
+                                          "intensities matching SetInputArrayToProcess(1, ...) (default: the active "
+                                          "scalars).");
+      return 0;
+    }
+    if (!internals.IntensityImage || internals.IntensitySource != image ||
+        internals.IntensitySourceTime != image->GetMTime() || internals.IntensityArray != intensities ||
+        internals.IntensityArrayTime != intensities->GetMTime())
+    {
+      try
+      {
+        internals.IntensityImage =
+          edm::ImageDataToImage<vtkDeformableMeshInternals::FilterType::IntensityImageType>(image, intensities);
+      }
+      catch (const itk::ExceptionObject & error)
+      {
+        vtkErrorMacro("Cannot convert the intensities: " << error.GetDescription());
+        internals.IntensityImage = nullptr;
+        return 0;
+      }
+      catch (const std::bad_alloc &)
+      {
+        vtkErrorMacro("Out of memory converting the intensities of " << image->GetNumberOfPoints() << " voxels.");
+        internals.IntensityImage = nullptr;
+        return 0;
+      }
+      internals.IntensitySource = image;
+      internals.IntensitySourceTime = image->GetMTime();
+      internals.IntensityArray = intensities;
+      internals.IntensityArrayTime = intensities->GetMTime();
+    }
+    filter->SetIntensityImage(internals.IntensityImage);
+  }
+  filter->SetRegionWeight(this->RegionWeight);
+  filter->SetRegionSigma(this->RegionSigma);
+  filter->SetIntensityTolerance(this->IntensityTolerance);
   filter->SetScaleFactor(this->ScaleFactor);
   filter->SetElasticity(this->Elasticity);
   filter->SetTangentialElasticity(this->TangentialElasticity != 0);
@@ -234,6 +287,9 @@ vtkDeformableMesh::PrintSelf(ostream & os, vtkIndent indent)
   os << indent << "TangentialElasticity: " << (this->TangentialElasticity ? "On" : "Off") << "\n";
   os << indent << "Rigidity: " << this->Rigidity << "\n";
   os << indent << "Balloon: " << this->Balloon << "\n";
+  os << indent << "RegionWeight: " << this->RegionWeight << "\n";
+  os << indent << "RegionSigma: " << this->RegionSigma << "\n";
+  os << indent << "IntensityTolerance: " << this->IntensityTolerance << "\n";
   os << indent << "MaximumStepLength: " << this->MaximumStepLength << "\n";
   os << indent << "ConvergenceTolerance: " << this->ConvergenceTolerance << "\n";
   os << indent << "ConvergenceWindow: " << this->ConvergenceWindow << "\n";

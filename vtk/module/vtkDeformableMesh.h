@@ -37,7 +37,10 @@ class vtkImageData;
  *   three-component point array in physical space (origin, spacing and
  *   direction honoured), chosen with SetInputArrayToProcess(0, 1, 0,
  *   vtkDataObject::FIELD_ASSOCIATION_POINTS, name); by default the active
- *   vectors of port 1.
+ *   vectors of port 1. With RegionWeight > 0, the same image also holds the
+ *   intensities of the region force as a one-component point array, chosen
+ *   with SetInputArrayToProcess(1, 1, 0, ...); by default the active scalars
+ *   (vtkExternalForceField's output carries its input's scalars).
  *
  * The parameters and their defaults are the ITK filter's (the constructor
  * reads the defaults from it); itk::DeformableMeshFilter documents each one
@@ -141,6 +144,37 @@ public:
 
   ///@{
   /**
+   * Weight of the region force: the largest inflation (intensity inside the
+   * object's range, estimated inside the initial surface) or deflation
+   * (outside it) per iteration; 0: off. Millimetres per iteration, at least
+   * 0; default 0. Meaning in full: itk::DeformableMeshFilter::SetRegionWeight().
+   */
+  vtkSetClampMacro(RegionWeight, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(RegionWeight, double);
+  ///@}
+
+  ///@{
+  /**
+   * Gaussian smoothing of the intensities for the region force.
+   * Millimetres, at least 0; default 1.
+   * Meaning in full: itk::DeformableMeshFilter::SetRegionSigma().
+   */
+  vtkSetClampMacro(RegionSigma, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(RegionSigma, double);
+  ///@}
+
+  ///@{
+  /**
+   * Half-width of the estimated object intensity range, in robust standard
+   * deviations. Positive; default 2.2.
+   * Meaning in full: itk::DeformableMeshFilter::SetIntensityTolerance().
+   */
+  vtkSetClampMacro(IntensityTolerance, double, 1e-6, VTK_DOUBLE_MAX);
+  vtkGetMacro(IntensityTolerance, double);
+  ///@}
+
+  ///@{
+  /**
    * Bound on a vertex's displacement per iteration; 0: no bound.
    * Millimetres, at least 0; default 0.
    * Meaning in full: itk::DeformableMeshFilter::SetMaximumStepLength().
@@ -206,6 +240,9 @@ protected:
   double      Rigidity = 0.0;
   double      Balloon = 0.0;
   double      MaximumStepLength = 0.0;
+  double      RegionWeight = 0.0;
+  double      RegionSigma = 1.0;
+  double      IntensityTolerance = 2.2;
   double      ConvergenceTolerance = 0.0;
   int         ConvergenceWindow = 3;
   vtkTypeBool ComputeDiagnostics = 1;

@@ -654,6 +654,62 @@ TEST(VTKIterativeAlgorithms, ProgressIsReportedAndAbortStopsBetweenSteps)
   EXPECT_EQ(Coordinates(warp->GetOutput()), ReferenceWarp(sphere, 20, 1.0, 0));
 }
 
+TEST(VTKIterativeAlgorithms, DeformableMeshRegionForceIsTheITKFilterAndStopsOnTheEllipsoid)
+{
+  // The intensities ride on the force image as its active scalars, as
+  // vtkExternalForceField's output carries them; no external force.
+  ImageType::SizeType size;
+  size.Fill(48);
+  ImageType::SpacingType spacing;
+  spacing.Fill(1.0);
+  ImageType::PointType origin;
+  origin.Fill(0.0);
+  const auto image =
+    MakeEllipsoid().MakeImage<ImageType>(size, spacing, origin, ImageType::DirectionType::GetIdentity(), 255, 0);
+  const auto forces = MakeForces();
+  forces->FillBuffer(itk::CovariantVector<float, 3>(0.0f));
+  auto       forceImage = edm::ImageToImageData(forces.GetPointer(), "Force");
+  const auto intensities = edm::ImageToImageData(image.GetPointer(), "Intensity");
+  forceImage->GetPointData()->AddArray(intensities->GetPointData()->GetArray("Intensity"));
+  forceImage->GetPointData()->SetActiveScalars("Intensity");
+  auto sphere = MakeSphere(5.0, Center);
+
+  vtkNew<vtkDeformableMesh> deformable;
+  deformable->SetInputData(sphere);
+  deformable->SetForceImageData(forceImage);
+  deformable->SetScaleFactor(0.0);
+  deformable->SetRegionWeight(0.25);
+  deformable->SetElasticity(0.3);
+  deformable->SetTangentialElasticity(false);
+  deformable->SetRigidity(0.05);
+  deformable->SetNumberOfIterations(600);
+  deformable->Update();
+
+  auto filter = itk::DeformableMeshFilter<MeshType, ForceImageType>::New();
+  filter->SetInput(ToITK(sphere));
+  filter->SetForceImage(forces);
+  filter->SetIntensityImage(image);
+  filter->SetScaleFactor(0.0);
+  filter->SetRegionWeight(0.25);
+  filter->SetElasticity(0.3);
+  filter->SetTangentialElasticity(false);
+  filter->SetRigidity(0.05);
+  filter->SetNumberOfIterations(600);
+  filter->Update();
+  EXPECT_EQ(Coordinates(deformable->GetOutput()), Coordinates(filter->GetOutput()));
+  // Known answer: from 5 mm inside everywhere to the ellipsoid's surface.
+  EXPECT_LT(MeanDistanceToEllipsoid(deformable->GetOutput()), 0.3);
+
+  // Without intensities: an error and an empty output.
+  forceImage->GetPointData()->RemoveArray("Intensity");
+  ErrorRecorder errors(deformable);
+  deformable->Modified();
+  deformable->Update();
+  EXPECT_GE(errors.Count(), 1);
+  EXPECT_NE(errors.Messages().find("intensities"), std::string::npos) << errors.Messages();
+  EXPECT_EQ(deformable->GetOutput()->GetNumberOfPoints(), 0);
+}
+
 TEST(VTKIterativeAlgorithms, PrintSelfPrintsEveryParameter)
 {
   vtkNew<vtkDeformableMesh> deformable;
@@ -668,6 +724,9 @@ TEST(VTKIterativeAlgorithms, PrintSelfPrintsEveryParameter)
                              "TangentialElasticity",
                              "Rigidity",
                              "Balloon: 0.125",
+                             "RegionWeight",
+                             "RegionSigma",
+                             "IntensityTolerance",
                              "MaximumStepLength",
                              "ConvergenceTolerance",
                              "ConvergenceWindow",
