@@ -26,7 +26,7 @@
 #include <type_traits>
 
 // The step's kernels, compiled for several instruction sets in one binary:
-// the same code (itkDeformableMeshFilterVec4.h, itkDeformableMeshFilterKernelBody.h)
+// the same code (itkDeformableMeshFilterVec4.inc, itkDeformableMeshFilterKernelBody.inc)
 // is included once per instruction set, each time in a namespace of its own,
 // and the AVX2 one under a target pragma, so that a portable build carries an
 // AVX2 and FMA path that GetKernelPath() selects on processors that have
@@ -68,8 +68,8 @@ namespace DeformableMeshFilterDetail
 namespace Portable
 {
 #define EDM_KERNEL_ISA EDM_ISA_PORTABLE
-#include "itkDeformableMeshFilterVec4.h"
-#include "itkDeformableMeshFilterKernelBody.h"
+#include "itkDeformableMeshFilterVec4.inc"
+#include "itkDeformableMeshFilterKernelBody.inc"
 #undef EDM_KERNEL_ISA
 } // namespace Portable
 
@@ -77,8 +77,8 @@ namespace Portable
 namespace SSE2
 {
 #  define EDM_KERNEL_ISA EDM_ISA_SSE2
-#  include "itkDeformableMeshFilterVec4.h"
-#  include "itkDeformableMeshFilterKernelBody.h"
+#  include "itkDeformableMeshFilterVec4.inc"
+#  include "itkDeformableMeshFilterKernelBody.inc"
 #  undef EDM_KERNEL_ISA
 } // namespace SSE2
 #endif
@@ -93,8 +93,8 @@ namespace SSE2
 namespace AVX2FMA
 {
 #  define EDM_KERNEL_ISA EDM_ISA_AVX2
-#  include "itkDeformableMeshFilterVec4.h"
-#  include "itkDeformableMeshFilterKernelBody.h"
+#  include "itkDeformableMeshFilterVec4.inc"
+#  include "itkDeformableMeshFilterKernelBody.inc"
 #  undef EDM_KERNEL_ISA
 } // namespace AVX2FMA
 #  if defined(__clang__)

@@ -44,7 +44,7 @@ namespace itk
  *
  * A new force term goes here as one more member and one more line in
  * Displacement(), in the kernels' StepBlock()
- * (itkDeformableMeshFilterKernelBody.h) where its input is sampled, as a
+ * (itkDeformableMeshFilterKernelBody.inc) where its input is sampled, as a
  * parameter of DeformableMeshFilter, and in the scalar reference test
  * (test/itkDeformableMeshFilterKernelsGTest.cxx), which holds the kernels against
  * this rule on irregular meshes with and without each term. A term that

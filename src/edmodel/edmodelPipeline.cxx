@@ -149,7 +149,7 @@ bool
 IsInsideImage(const ImageType * image, const MeshType::PointType & p)
 {
   itk::ContinuousIndex<double, 3> index;
-  image->TransformPhysicalPointToContinuousIndex(p, index);
+  static_cast<void>(image->TransformPhysicalPointToContinuousIndex(p, index)); // the region test follows
   const auto & region = image->GetLargestPossibleRegion();
   for (unsigned int k = 0; k < 3; ++k)
   {
