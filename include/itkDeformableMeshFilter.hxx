@@ -101,22 +101,9 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareForceSampler()
   }
   m_ForceBuffer = image->GetBufferPointer();
 
-  using MatrixType = Matrix<double, 3, 3>;
-  MatrixType indexToPhysical;
+  DeformableMeshFilterDetail::PhysicalToIndexMatrix(image, m_PhysicalToIndex);
   for (unsigned int r = 0; r < 3; ++r)
   {
-    for (unsigned int c = 0; c < 3; ++c)
-    {
-      indexToPhysical(r, c) = image->GetDirection()(r, c) * image->GetSpacing()[c];
-    }
-  }
-  const vnl_matrix<double> physicalToIndex = indexToPhysical.GetInverse().as_matrix();
-  for (unsigned int r = 0; r < 3; ++r)
-  {
-    for (unsigned int c = 0; c < 3; ++c)
-    {
-      m_PhysicalToIndex[r][c] = physicalToIndex(r, c);
-    }
     m_ForceOrigin[r] = image->GetOrigin()[r];
     m_BufferStart[r] = static_cast<double>(region.GetIndex()[r]);
     m_BufferSize[r] = static_cast<int64_t>(region.GetSize()[r]);

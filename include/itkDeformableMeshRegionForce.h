@@ -32,6 +32,31 @@ namespace itk
 namespace DeformableMeshFilterDetail
 {
 
+/** The matrix M that maps a physical point x to the continuous index
+ * M (x - origin) of \a image (the inverse of direction times spacing): the
+ * transform both the force sampler and the intensity sampler precompute. */
+template <typename TImage>
+void
+PhysicalToIndexMatrix(const TImage * image, double matrix[3][3])
+{
+  Matrix<double, 3, 3> indexToPhysical;
+  for (unsigned int r = 0; r < 3; ++r)
+  {
+    for (unsigned int c = 0; c < 3; ++c)
+    {
+      indexToPhysical(r, c) = image->GetDirection()(r, c) * image->GetSpacing()[c];
+    }
+  }
+  const vnl_matrix<double> physicalToIndex = indexToPhysical.GetInverse().as_matrix();
+  for (unsigned int r = 0; r < 3; ++r)
+  {
+    for (unsigned int c = 0; c < 3; ++c)
+    {
+      matrix[r][c] = physicalToIndex(r, c);
+    }
+  }
+}
+
 /** \class IntensitySampler
  * \brief Trilinear samples of a scalar image at physical points, read
  * through its buffer with the physical-to-index transform precomputed.
@@ -51,21 +76,9 @@ public:
   {
     m_Buffer = image->GetBufferPointer();
     const auto region = image->GetBufferedRegion();
-    Matrix<double, 3, 3> indexToPhysical;
+    PhysicalToIndexMatrix(image, m_Matrix);
     for (unsigned int r = 0; r < 3; ++r)
     {
-      for (unsigned int c = 0; c < 3; ++c)
-      {
-        indexToPhysical(r, c) = image->GetDirection()(r, c) * image->GetSpacing()[c];
-      }
-    }
-    const vnl_matrix<double> physicalToIndex = indexToPhysical.GetInverse().as_matrix();
-    for (unsigned int r = 0; r < 3; ++r)
-    {
-      for (unsigned int c = 0; c < 3; ++c)
-      {
-        m_Matrix[r][c] = physicalToIndex(r, c);
-      }
       m_Size[r] = static_cast<int64_t>(region.GetSize()[r]);
     }
     for (unsigned int r = 0; r < 3; ++r)

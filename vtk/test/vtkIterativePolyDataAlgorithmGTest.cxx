@@ -207,10 +207,10 @@ MakeEllipsoid()
   return itk::EllipsoidPhantom(center, radii);
 }
 
-/** ExternalForceImageFilter's force field (sigma 1 mm, normalised) of the
- * test ellipsoid. */
-ForceImageType::Pointer
-MakeForces()
+/** The test ellipsoid as a binary image (255 inside, 0 outside), 48^3 voxels
+ * of 1 mm. */
+ImageType::Pointer
+MakeEllipsoidImage()
 {
   ImageType::SizeType size;
   size.Fill(48);
@@ -218,9 +218,16 @@ MakeForces()
   spacing.Fill(1.0);
   ImageType::PointType origin;
   origin.Fill(0.0);
-  const auto image =
-    MakeEllipsoid().MakeImage<ImageType>(size, spacing, origin, ImageType::DirectionType::GetIdentity(), 255, 0);
-  auto forces = itk::ExternalForceImageFilter<ImageType, ForceImageType>::New();
+  return MakeEllipsoid().MakeImage<ImageType>(size, spacing, origin, ImageType::DirectionType::GetIdentity(), 255, 0);
+}
+
+/** ExternalForceImageFilter's force field (sigma 1 mm, normalised) of the
+ * test ellipsoid. */
+ForceImageType::Pointer
+MakeForces()
+{
+  const auto image = MakeEllipsoidImage();
+  auto       forces = itk::ExternalForceImageFilter<ImageType, ForceImageType>::New();
   forces->SetInput(image);
   forces->SetSigma(1.0);
   forces->Update();
@@ -658,14 +665,7 @@ TEST(VTKIterativeAlgorithms, DeformableMeshRegionForceIsTheITKFilterAndStopsOnTh
 {
   // The intensities ride on the force image as its active scalars, as
   // vtkExternalForceField's output carries them; no external force.
-  ImageType::SizeType size;
-  size.Fill(48);
-  ImageType::SpacingType spacing;
-  spacing.Fill(1.0);
-  ImageType::PointType origin;
-  origin.Fill(0.0);
-  const auto image =
-    MakeEllipsoid().MakeImage<ImageType>(size, spacing, origin, ImageType::DirectionType::GetIdentity(), 255, 0);
+  const auto image = MakeEllipsoidImage();
   const auto forces = MakeForces();
   forces->FillBuffer(itk::CovariantVector<float, 3>(0.0f));
   auto       forceImage = edm::ImageToImageData(forces.GetPointer(), "Force");
