@@ -416,9 +416,9 @@ RunDeformableMesh(benchmark::State & state, bool internalForces, unsigned int th
   state.counters["vertices"] = static_cast<double>(vertices);
   state.counters["vertex_it/s"] =
     benchmark::Counter(static_cast<double>(vertices * stepsRun), benchmark::Counter::kIsRate);
-  state.SetLabel(std::string(itk::DeformableMeshFilterDetail::KernelPathName(
-                   itk::DeformableMeshFilterDetail::GetKernelPath())) +
-                 ", steps/update=" + std::to_string(steps));
+  state.SetLabel(
+    std::string(itk::DeformableMeshFilterDetail::KernelPathName(itk::DeformableMeshFilterDetail::GetKernelPath())) +
+    ", steps/update=" + std::to_string(steps));
 }
 
 void

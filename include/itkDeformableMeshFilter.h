@@ -406,26 +406,26 @@ private:
 
   // Image terms: the smoothed intensity image (kept while the input image and
   // RegionSigma are unchanged), its sampler and the object's model.
-  typename IntensityImageType::Pointer             m_SmoothedIntensity;
-  ModifiedTimeType                                 m_SmoothedIntensityTime{ 0 };
-  const IntensityImageType *                       m_SmoothedIntensitySource{ nullptr };
-  double                                           m_SmoothedIntensitySigma{ -1.0 };
-  DeformableMeshFilterDetail::IntensitySampler     m_IntensitySampler;
-  DeformableMeshFilterDetail::RegionForce          m_RegionForce;
-  double                                           m_IntensityQuantiles[2]{}; // 2nd and 98th percentiles
-  double                                           m_IntensityScale{ 1.0 };   // power of two applied before smoothing
+  typename IntensityImageType::Pointer         m_SmoothedIntensity;
+  ModifiedTimeType                             m_SmoothedIntensityTime{ 0 };
+  const IntensityImageType *                   m_SmoothedIntensitySource{ nullptr };
+  double                                       m_SmoothedIntensitySigma{ -1.0 };
+  DeformableMeshFilterDetail::IntensitySampler m_IntensitySampler;
+  DeformableMeshFilterDetail::RegionForce      m_RegionForce;
+  double                                       m_IntensityQuantiles[2]{}; // 2nd and 98th percentiles
+  double                                       m_IntensityScale{ 1.0 };   // power of two applied before smoothing
   using RegionForceType = DeformableMeshFilterDetail::RegionForce;
-  std::vector<float>   m_DisplacementMagnitudes;
-  std::vector<float>   m_ExternalForceMagnitudes;
-  std::vector<float>   m_InternalForceMagnitudes;
+  std::vector<float> m_DisplacementMagnitudes;
+  std::vector<float> m_ExternalForceMagnitudes;
+  std::vector<float> m_InternalForceMagnitudes;
 
   // Force sampler, prepared at each update: continuous index
   // c = M (x - origin) - bufferStart, with M's columns as vectors.
-  const ForcePixelType * m_ForceBuffer{ nullptr };
-  double                 m_PhysicalToIndex[3][3]{};
-  double                 m_ForceOrigin[3]{};
-  double                 m_BufferStart[3]{};
-  int64_t                m_BufferSize[3]{};
+  const ForcePixelType *                                   m_ForceBuffer{ nullptr };
+  double                                                   m_PhysicalToIndex[3][3]{};
+  double                                                   m_ForceOrigin[3]{};
+  double                                                   m_BufferStart[3]{};
+  int64_t                                                  m_BufferSize[3]{};
   DeformableMeshFilterDetail::ForceSampler<ForcePixelType> m_Sampler{};
 };
 } // end namespace itk

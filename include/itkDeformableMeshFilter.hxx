@@ -492,10 +492,10 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
       m_Normals.assign(4 * numberOfPoints, 0.0f);
     }
   }
-  const MeshTables mesh{ m_NeighbourOffsets.data(),   m_Neighbours.data(),
-                         m_RingKinds.data(),          m_GeneralVertices.data(),
-                         m_GeneralVertices.size(),    m_GeneralPairOffsets.data(),
-                         m_GeneralPairs.data(),       ordered ? m_ValenceOrder.data() : nullptr };
+  const MeshTables mesh{ m_NeighbourOffsets.data(), m_Neighbours.data(),
+                         m_RingKinds.data(),        m_GeneralVertices.data(),
+                         m_GeneralVertices.size(),  m_GeneralPairOffsets.data(),
+                         m_GeneralPairs.data(),     ordered ? m_ValenceOrder.data() : nullptr };
   StepArrays       arrays{ coordinates.data(),
                      m_NextCoordinates.data(),
                      m_Umbrella.data(),
@@ -532,9 +532,10 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   // sums are scaled.
   const double    internalSum = m_Elasticity + 2.0 * m_Rigidity;
   const double    internalScale = internalSum > 1.0 ? 1.0 / internalSum : 1.0;
-  const StepTerms terms{ m_ScaleFactor,      m_Elasticity * internalScale, m_Rigidity * internalScale,
-                         m_TangentialElasticity, m_Balloon,                   m_MaximumStepLength,
-                         m_OrientationSign };
+  const StepTerms terms{
+    m_ScaleFactor, m_Elasticity * internalScale, m_Rigidity * internalScale, m_TangentialElasticity,
+    m_Balloon,     m_MaximumStepLength,          m_OrientationSign
+  };
   std::vector<double> blockMaximum(numberOfBlocks, 0.0);
   threader->ParallelizeArray(
     0,
@@ -582,8 +583,8 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "RegionSigma: " << m_RegionSigma << std::endl;
   os << indent << "IntensityTolerance: " << m_IntensityTolerance << std::endl;
   os << indent << "EstimateObjectIntensityRange: " << m_EstimateObjectIntensityRange << std::endl;
-  os << indent << "ObjectIntensityRange: [" << m_ObjectIntensityLower << ", " << m_ObjectIntensityUpper
-     << "], width " << m_ObjectIntensityWidth << std::endl;
+  os << indent << "ObjectIntensityRange: [" << m_ObjectIntensityLower << ", " << m_ObjectIntensityUpper << "], width "
+     << m_ObjectIntensityWidth << std::endl;
   os << indent << "MaximumStepLength: " << m_MaximumStepLength << std::endl;
   os << indent << "ConvergenceTolerance: " << m_ConvergenceTolerance << std::endl;
   os << indent << "ConvergenceWindow: " << m_ConvergenceWindow << std::endl;

@@ -172,9 +172,9 @@ DeformableMeshFilter<TMesh, TForceImage>::UpdateNormalSpeeds()
   {
     m_NormalSpeeds.assign(numberOfPoints, 0.0f);
   }
-  const double * x = this->GetCoordinates().data();
-  float *        speeds = m_NormalSpeeds.data();
-  const double   weight = m_RegionWeight;
+  const double *          x = this->GetCoordinates().data();
+  float *                 speeds = m_NormalSpeeds.data();
+  const double            weight = m_RegionWeight;
   constexpr SizeValueType blockSize = 4096;
   const SizeValueType     numberOfBlocks = (numberOfPoints + blockSize - 1) / blockSize;
   this->GetMultiThreader()->ParallelizeArray(

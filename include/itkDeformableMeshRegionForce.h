@@ -118,13 +118,13 @@ public:
     }
     const int64_t sy = m_Size[0];
     const int64_t sz = m_Size[0] * m_Size[1];
-    const auto    at = [&](int64_t i, int64_t j, int64_t k) { return static_cast<double>(m_Buffer[i + sy * j + sz * k]); };
-    const double  c00 = at(lo[0], lo[1], lo[2]) + w[0] * (at(hi[0], lo[1], lo[2]) - at(lo[0], lo[1], lo[2]));
-    const double  c10 = at(lo[0], hi[1], lo[2]) + w[0] * (at(hi[0], hi[1], lo[2]) - at(lo[0], hi[1], lo[2]));
-    const double  c01 = at(lo[0], lo[1], hi[2]) + w[0] * (at(hi[0], lo[1], hi[2]) - at(lo[0], lo[1], hi[2]));
-    const double  c11 = at(lo[0], hi[1], hi[2]) + w[0] * (at(hi[0], hi[1], hi[2]) - at(lo[0], hi[1], hi[2]));
-    const double  c0 = c00 + w[1] * (c10 - c00);
-    const double  c1 = c01 + w[1] * (c11 - c01);
+    const auto at = [&](int64_t i, int64_t j, int64_t k) { return static_cast<double>(m_Buffer[i + sy * j + sz * k]); };
+    const double c00 = at(lo[0], lo[1], lo[2]) + w[0] * (at(hi[0], lo[1], lo[2]) - at(lo[0], lo[1], lo[2]));
+    const double c10 = at(lo[0], hi[1], lo[2]) + w[0] * (at(hi[0], hi[1], lo[2]) - at(lo[0], hi[1], lo[2]));
+    const double c01 = at(lo[0], lo[1], hi[2]) + w[0] * (at(hi[0], lo[1], hi[2]) - at(lo[0], lo[1], hi[2]));
+    const double c11 = at(lo[0], hi[1], hi[2]) + w[0] * (at(hi[0], hi[1], hi[2]) - at(lo[0], hi[1], hi[2]));
+    const double c0 = c00 + w[1] * (c10 - c00);
+    const double c1 = c01 + w[1] * (c11 - c01);
     return c0 + w[2] * (c1 - c0);
   }
 
@@ -227,7 +227,7 @@ public:
       value = std::abs(value - centre);
     }
     const double spread = 1.4826 * median(samples);
-    double halfWidth = tolerance * spread;
+    double       halfWidth = tolerance * spread;
     if (!(halfWidth >= 0.2 * (high - low)))
     {
       halfWidth = std::max(0.5 * (centre - low), 0.5 * (high - centre));
@@ -241,9 +241,9 @@ public:
   static std::vector<double>
   Quantiles(const Image<float, 3> * image, const std::vector<double> & q)
   {
-    const float *  buffer = image->GetBufferPointer();
-    const size_t   count = image->GetBufferedRegion().GetNumberOfPixels();
-    const size_t   stride = std::max<size_t>(1, count / 1000000) | 1; // odd: no alignment with rows
+    const float *      buffer = image->GetBufferPointer();
+    const size_t       count = image->GetBufferedRegion().GetNumberOfPixels();
+    const size_t       stride = std::max<size_t>(1, count / 1000000) | 1; // odd: no alignment with rows
     std::vector<float> values;
     values.reserve(count / stride + 1);
     for (size_t i = 0; i < count; i += stride)

@@ -72,8 +72,7 @@ Info(const std::string & referencePath)
   const MaskType::Pointer mask = ReadMask(referencePath);
   double                  sum[3] = { 0.0, 0.0, 0.0 };
   double                  count = 0.0;
-  for (itk::ImageRegionConstIteratorWithIndex<MaskType> it(mask, mask->GetLargestPossibleRegion()); !it.IsAtEnd();
-       ++it)
+  for (itk::ImageRegionConstIteratorWithIndex<MaskType> it(mask, mask->GetLargestPossibleRegion()); !it.IsAtEnd(); ++it)
   {
     if (it.Get() != 0)
     {
@@ -109,9 +108,9 @@ Score(const std::string & meshPath, const std::string & referencePath, double mi
   voxelise->Update();
   const MaskType * segmentation = voxelise->GetOutput();
 
-  double both = 0.0;
-  double inReference = 0.0;
-  double inSegmentation = 0.0;
+  double                                           both = 0.0;
+  double                                           inReference = 0.0;
+  double                                           inSegmentation = 0.0;
   itk::ImageRegionConstIteratorWithIndex<MaskType> r(reference, reference->GetLargestPossibleRegion());
   itk::ImageRegionConstIteratorWithIndex<MaskType> s(segmentation, reference->GetLargestPossibleRegion());
   for (; !r.IsAtEnd(); ++r, ++s)

@@ -55,12 +55,12 @@ namespace defaults
  * (so 1 mm on the seed's 1 mm grid). */
 constexpr double SigmaInVoxels = 1.0;
 /** Largest external displacement per iteration, as a fraction of Sigma. */
-constexpr double       ScaleOverSigma = 0.5;
-constexpr double       Elasticity = 0.3;
+constexpr double ScaleOverSigma = 0.5;
+constexpr double Elasticity = 0.3;
 /** The full umbrella operator (not only its tangential part, the core's
  * default): with the region force, the normal part is what keeps the
  * surface from folding into dark pockets (ventricles, sulci). */
-constexpr bool TangentialElasticity = false;
+constexpr bool         TangentialElasticity = false;
 constexpr double       Rigidity = 0.05;
 constexpr unsigned int Iterations = 500;
 constexpr double       ConvergenceTolerance = 0.01;

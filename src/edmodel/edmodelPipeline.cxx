@@ -289,7 +289,7 @@ SubdivideTriangles(const MeshType * mesh)
   {
     points->SetElement(it.Index(), it.Value());
   }
-  itk::IdentifierType                         next = mesh->GetNumberOfPoints();
+  itk::IdentifierType                                                                next = mesh->GetNumberOfPoints();
   std::map<std::pair<itk::IdentifierType, itk::IdentifierType>, itk::IdentifierType> midpoints;
   const auto midpoint = [&](itk::IdentifierType a, itk::IdentifierType b) {
     const auto key = std::make_pair(std::min(a, b), std::max(a, b));
@@ -402,8 +402,7 @@ Deform(const ImageType *        image,
     o.regionWeight >= 0.0 ? o.regionWeight : defaults::RegionWeightInVoxels * SmallestSpacing(image);
   const double regionSigma =
     o.regionSigma >= 0.0 ? o.regionSigma : defaults::RegionSigmaInVoxels * SmallestSpacing(image);
-  const double edgeLength =
-    o.edgeLength > 0.0 ? o.edgeLength : defaults::EdgeLengthInVoxels * SmallestSpacing(image);
+  const double edgeLength = o.edgeLength > 0.0 ? o.edgeLength : defaults::EdgeLengthInVoxels * SmallestSpacing(image);
   MeshType::ConstPointer stageInput = initial;
   bool                   haveRange = o.hasObjectRange;
   double                 range[3] = { o.objectRange[0], o.objectRange[1], 0.1 * (o.objectRange[1] - o.objectRange[0]) };
@@ -483,8 +482,8 @@ Deform(const ImageType *        image,
     result.lastMaximumDisplacement = deform->GetLastMaximumDisplacement();
     const double deformSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - deformStart).count();
     progress.Finish(std::to_string(deform->GetCurrentIteration()) + " iterations on " + level + ", " +
-                    (result.converged ? "converged (largest step below " + Format(o.convergenceTolerance) +
-                                          " mm for " + std::to_string(o.convergenceWindow) + " iterations)"
+                    (result.converged ? "converged (largest step below " + Format(o.convergenceTolerance) + " mm for " +
+                                          std::to_string(o.convergenceWindow) + " iterations)"
                                       : std::string("iteration cap reached")) +
                     ", last largest step " + Format(result.lastMaximumDisplacement) + " mm (" +
                     Format(deformSeconds, 2) + " s)");
