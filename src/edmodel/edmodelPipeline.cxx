@@ -338,6 +338,56 @@ SubdivideTriangles(const MeshType * mesh)
   return output;
 }
 
+/** Volume enclosed by the mesh's triangles (absolute value of the signed
+ * volume), physical units. */
+double
+EnclosedVolume(const MeshType * mesh)
+{
+  double volume = 0.0;
+  for (auto cell = mesh->GetCells()->Begin(); cell != mesh->GetCells()->End(); ++cell)
+  {
+    const auto * c = cell.Value();
+    if (c->GetNumberOfPoints() != 3)
+    {
+      continue;
+    }
+    const auto * ids = c->GetPointIds();
+    const auto & a = mesh->GetPoint(ids[0]);
+    const auto & b = mesh->GetPoint(ids[1]);
+    const auto & d = mesh->GetPoint(ids[2]);
+    volume += a[0] * (b[1] * d[2] - b[2] * d[1]) - a[1] * (b[0] * d[2] - b[2] * d[0]) + a[2] * (b[0] * d[1] - b[1] * d[0]);
+  }
+  return std::abs(volume) / 6.0;
+}
+
+/** A surface that left the image or collapsed is a failed run (exit 1),
+ * not a result: nothing is written. */
+void
+CheckFinalSurface(const ImageType * image, const MeshType * initial, const MeshType * final)
+{
+  size_t outside = 0;
+  for (auto it = final->GetPoints()->Begin(); it != final->GetPoints()->End(); ++it)
+  {
+    outside += IsInsideImage(image, it.Value()) ? 0 : 1;
+  }
+  if (outside > 0)
+  {
+    throw Error("the surface left the image: " + std::to_string(outside) + " of " +
+                  std::to_string(final->GetNumberOfPoints()) +
+                  " points lie outside it (a balloon or region force too strong for the image's edges?); nothing "
+                  "written",
+                ExitFailure);
+  }
+  const double before = EnclosedVolume(initial);
+  const double after = EnclosedVolume(final);
+  if (before > 0.0 && after < 1e-3 * before)
+  {
+    throw Error("the surface collapsed: it encloses " + Format(after) + " mm^3, " + Format(100.0 * after / before) +
+                  " % of the initial " + Format(before) + " mm^3; nothing written",
+                ExitFailure);
+  }
+}
+
 struct DeformResult
 {
   MeshType::Pointer       mesh;
@@ -610,6 +660,7 @@ RunSegment(const SegmentOptions & o, const GlobalOptions & global)
 #endif
 
   const DeformResult result = Deform(image, initial, o, progress, snapshot);
+  CheckFinalSurface(image, initial, result.mesh);
 
   if (!o.forceOutput.empty())
   {
