@@ -24,5 +24,10 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:exitcode=23"
 export EDM_NO_MEMORY_LIMIT=1
 # Not the packaging test (an install and a downstream build), the real-image
 # validation (minutes under the sanitizers) nor the reruns of the suite with
-# other kernels (KernelPath): the default kernel's run is sanitized.
-ctest --test-dir "$build" --output-on-failure -j2 -E "InstallDownstream|^validation\.|KernelPath"
+# other kernels (KernelPath): the default kernel's run is sanitized. Nor the
+# bit-for-bit comparison with the step before the kernel split
+# (ThreeHundredSteps): at -O1 the compiler inlines and contracts into FMAs
+# differently, so the bits of a 300-step run differ by rounding; stage 1
+# checks them in the Release build, and the sanitizers still run every other
+# test of the step.
+ctest --test-dir "$build" --output-on-failure -j2 -E "InstallDownstream|^validation\.|KernelPath|ThreeHundredSteps"
