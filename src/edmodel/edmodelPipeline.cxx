@@ -251,6 +251,21 @@ CheckInitialMesh(const ImageType * image, const MeshType * mesh, const std::stri
   }
 }
 
+/** True when every cell of the mesh is a triangle: only such meshes are
+ * refined (SubdivideTriangles() would drop other cells). */
+bool
+HasOnlyTriangles(const MeshType * mesh)
+{
+  for (auto cell = mesh->GetCells()->Begin(); cell != mesh->GetCells()->End(); ++cell)
+  {
+    if (cell.Value()->GetNumberOfPoints() != 3)
+    {
+      return false;
+    }
+  }
+  return mesh->GetNumberOfCells() > 0;
+}
+
 /** Mean length of the edges of the mesh's triangles (each edge counted once
  * per triangle side), physical units. */
 double
@@ -355,7 +370,8 @@ EnclosedVolume(const MeshType * mesh)
     const auto & a = mesh->GetPoint(ids[0]);
     const auto & b = mesh->GetPoint(ids[1]);
     const auto & d = mesh->GetPoint(ids[2]);
-    volume += a[0] * (b[1] * d[2] - b[2] * d[1]) - a[1] * (b[0] * d[2] - b[2] * d[0]) + a[2] * (b[0] * d[1] - b[1] * d[0]);
+    volume +=
+      a[0] * (b[1] * d[2] - b[2] * d[1]) - a[1] * (b[0] * d[2] - b[2] * d[0]) + a[2] * (b[0] * d[1] - b[1] * d[0]);
   }
   return std::abs(volume) / 6.0;
 }
@@ -464,9 +480,11 @@ Deform(const ImageType *        image,
   for (unsigned int stage = 0;; ++stage)
   {
     auto deform = DeformFilterType::New();
-    // The last level: refinement off (no region force), or a first level
-    // already fine enough (later levels are decided on their output below).
-    bool last = regionWeight == 0.0 || !(MeanEdgeLength(stageInput) > 1.5 * edgeLength);
+    // The last level: refinement off (no region force), a mesh with cells
+    // other than triangles (not refined), or a first level already fine
+    // enough (later levels are decided on their output below).
+    bool last =
+      regionWeight == 0.0 || !HasOnlyTriangles(stageInput) || !(MeanEdgeLength(stageInput) > 1.5 * edgeLength);
     deform->SetInput(stageInput);
     deform->SetForceImage(result.force);
     deform->SetScaleFactor(result.scale);
