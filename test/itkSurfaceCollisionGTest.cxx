@@ -1,0 +1,514 @@
+/*=========================================================================
+ *
+ *  Copyright NumFOCUS
+ *
+ *  Licensed under the Apache License, Version 2.0 (the "License");
+ *  you may not use this file except in compliance with the License.
+ *  You may obtain a copy of the License at
+ *
+ *         http://www.apache.org/licenses/LICENSE-2.0.txt
+ *
+ *  Unless required by applicable law or agreed to in writing, software
+ *  distributed under the License is distributed on an "AS IS" BASIS,
+ *  WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+ *  See the License for the specific language governing permissions and
+ *  limitations under the License.
+ *
+ *=========================================================================*/
+
+// SurfaceCollision: the triangle-triangle intersection test and distance on
+// known configurations, the index against an all-pairs count, Constrain() on
+// fronts pushed through each other.
+
+#include "itkSurfaceCollision.h"
+#include "itkEllipsoidPhantom.h"
+#include "itkMesh.h"
+
+#include "gtest/gtest.h"
+
+#include <array>
+#include <cmath>
+#include <random>
+#include <vector>
+
+namespace
+{
+using itk::SurfaceCollisionDetail::TriangleDistance;
+using itk::SurfaceCollisionDetail::TrianglesIntersect;
+using Triangle = std::vector<std::array<double, 3>>;
+using MeshType = itk::Mesh<double, 3, itk::DefaultStaticMeshTraits<double, 3, 3, double, double, double>>;
+
+bool
+Intersect(const Triangle & a, const Triangle & b)
+{
+  const double * pa[3] = { a[0].data(), a[1].data(), a[2].data() };
+  const double * pb[3] = { b[0].data(), b[1].data(), b[2].data() };
+  const bool     ab = TrianglesIntersect(pa, pb);
+  EXPECT_EQ(ab, TrianglesIntersect(pb, pa)) << "the test is symmetric";
+  return ab;
+}
+
+double
+Distance(const Triangle & a, const Triangle & b)
+{
+  const double * pa[3] = { a[0].data(), a[1].data(), a[2].data() };
+  const double * pb[3] = { b[0].data(), b[1].data(), b[2].data() };
+  const double   ab = TriangleDistance(pa, pb);
+  EXPECT_NEAR(ab, TriangleDistance(pb, pa), 1e-15 * (1.0 + ab)) << "the distance is symmetric";
+  return ab;
+}
+
+// ---------------------------------------------------------------------------
+// An independent all-pairs test, written for these tests: Moller-Trumbore
+// segment-triangle crossings of the 6 edges, and distances from the closest
+// points of segments and triangles by projection (not the component's
+// Voronoi-region code), every pair of triangles sharing no vertex, no index.
+using Vec = std::array<double, 3>;
+Vec
+Sub(const Vec & a, const Vec & b)
+{
+  return { a[0] - b[0], a[1] - b[1], a[2] - b[2] };
+}
+double
+DotV(const Vec & a, const Vec & b)
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+Vec
+CrossV(const Vec & a, const Vec & b)
+{
+  return { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
+}
+Vec
+Along(const Vec & a, const Vec & b, double t)
+{
+  return { a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2]) };
+}
+
+/** The segment [p, q] meets the triangle (Moller-Trumbore, closed). */
+bool
+SegmentHitsTriangle(const Vec & p, const Vec & q, const Vec & a, const Vec & b, const Vec & c)
+{
+  const Vec    direction = Sub(q, p);
+  const Vec    e1 = Sub(b, a);
+  const Vec    e2 = Sub(c, a);
+  const Vec    h = CrossV(direction, e2);
+  const double det = DotV(e1, h);
+  if (std::abs(det) < 1e-300)
+  {
+    return false; // parallel: not a crossing (the meshes here are never coplanar)
+  }
+  const double inv = 1.0 / det;
+  const Vec    s = Sub(p, a);
+  const double u = inv * DotV(s, h);
+  if (u < 0.0 || u > 1.0)
+  {
+    return false;
+  }
+  const Vec    qv = CrossV(s, e1);
+  const double v = inv * DotV(direction, qv);
+  if (v < 0.0 || u + v > 1.0)
+  {
+    return false;
+  }
+  const double t = inv * DotV(e2, qv);
+  return t >= 0.0 && t <= 1.0;
+}
+
+double
+PointSegment(const Vec & p, const Vec & a, const Vec & b)
+{
+  const Vec    ab = Sub(b, a);
+  const double l = DotV(ab, ab);
+  const double t = l > 0.0 ? std::min(1.0, std::max(0.0, DotV(Sub(p, a), ab) / l)) : 0.0;
+  const Vec    d = Sub(p, Along(a, b, t));
+  return std::sqrt(DotV(d, d));
+}
+
+double
+PointTriangle(const Vec & p, const Vec & a, const Vec & b, const Vec & c)
+{
+  // Projection on the plane; inside (barycentric coordinates >= 0): the
+  // height; otherwise the nearest edge.
+  const Vec    n = CrossV(Sub(b, a), Sub(c, a));
+  const double nn = DotV(n, n);
+  const double h = DotV(Sub(p, a), n) / nn;
+  const Vec    f = { p[0] - h * n[0], p[1] - h * n[1], p[2] - h * n[2] };
+  const double wa = DotV(CrossV(Sub(b, f), Sub(c, f)), n);
+  const double wb = DotV(CrossV(Sub(c, f), Sub(a, f)), n);
+  const double wc = DotV(CrossV(Sub(a, f), Sub(b, f)), n);
+  if (wa >= 0.0 && wb >= 0.0 && wc >= 0.0)
+  {
+    return std::abs(h) * std::sqrt(nn);
+  }
+  return std::min({ PointSegment(p, a, b), PointSegment(p, b, c), PointSegment(p, c, a) });
+}
+
+double
+SegmentSegment(const Vec & p0, const Vec & p1, const Vec & q0, const Vec & q1)
+{
+  // The interior critical point of the two lines when both parameters fall
+  // in [0, 1]; otherwise an end of one is a closest point.
+  double best = std::min(
+    { PointSegment(p0, q0, q1), PointSegment(p1, q0, q1), PointSegment(q0, p0, p1), PointSegment(q1, p0, p1) });
+  const Vec    u = Sub(p1, p0);
+  const Vec    v = Sub(q1, q0);
+  const Vec    w = Sub(p0, q0);
+  const double a = DotV(u, u), b = DotV(u, v), c = DotV(v, v), d = DotV(u, w), e = DotV(v, w);
+  const double den = a * c - b * b;
+  if (den > 1e-12 * a * c)
+  {
+    const double s = (b * e - c * d) / den;
+    const double t = (a * e - b * d) / den;
+    if (s >= 0.0 && s <= 1.0 && t >= 0.0 && t <= 1.0)
+    {
+      const Vec g = Sub(Along(p0, p1, s), Along(q0, q1, t));
+      best = std::min(best, std::sqrt(DotV(g, g)));
+    }
+  }
+  return best;
+}
+
+struct BruteForce
+{
+  std::size_t intersecting{ 0 };
+  double      smallestDistance{ std::numeric_limits<double>::infinity() };
+};
+
+/** Every pair of triangles sharing no vertex: crossing edges, and the
+ * smallest distance of the pairs whose boxes are within \a range. */
+BruteForce
+CheckAllPairs(const std::vector<double> & x, const std::vector<uint32_t> & triangles, double range)
+{
+  const std::size_t n = triangles.size() / 3;
+  std::vector<Vec>  box(2 * n);
+  auto              point = [&](uint32_t i) { return Vec{ x[3 * i], x[3 * i + 1], x[3 * i + 2] }; };
+  for (std::size_t t = 0; t < n; ++t)
+  {
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      box[2 * t][k] =
+        std::min({ x[3 * triangles[3 * t] + k], x[3 * triangles[3 * t + 1] + k], x[3 * triangles[3 * t + 2] + k] });
+      box[2 * t + 1][k] =
+        std::max({ x[3 * triangles[3 * t] + k], x[3 * triangles[3 * t + 1] + k], x[3 * triangles[3 * t + 2] + k] });
+    }
+  }
+  BruteForce result;
+  for (std::size_t t = 0; t < n; ++t)
+  {
+    for (std::size_t u = t + 1; u < n; ++u)
+    {
+      bool far = false;
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        far = far || box[2 * t][k] > box[2 * u + 1][k] + range || box[2 * u][k] > box[2 * t + 1][k] + range;
+      }
+      const uint32_t * a = triangles.data() + 3 * t;
+      const uint32_t * b = triangles.data() + 3 * u;
+      bool             shared = false;
+      for (unsigned int i = 0; i < 3; ++i)
+      {
+        for (unsigned int j = 0; j < 3; ++j)
+        {
+          shared = shared || a[i] == b[j];
+        }
+      }
+      if (far || shared)
+      {
+        continue;
+      }
+      const Vec pa[3] = { point(a[0]), point(a[1]), point(a[2]) };
+      const Vec pb[3] = { point(b[0]), point(b[1]), point(b[2]) };
+      bool      hit = false;
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        hit = hit || SegmentHitsTriangle(pa[k], pa[(k + 1) % 3], pb[0], pb[1], pb[2]) ||
+              SegmentHitsTriangle(pb[k], pb[(k + 1) % 3], pa[0], pa[1], pa[2]);
+      }
+      double d = 0.0;
+      if (hit)
+      {
+        ++result.intersecting;
+      }
+      else
+      {
+        d = std::numeric_limits<double>::infinity();
+        for (unsigned int k = 0; k < 3; ++k)
+        {
+          d = std::min({ d, PointTriangle(pa[k], pb[0], pb[1], pb[2]), PointTriangle(pb[k], pa[0], pa[1], pa[2]) });
+          for (unsigned int l = 0; l < 3; ++l)
+          {
+            d = std::min(d, SegmentSegment(pa[k], pa[(k + 1) % 3], pb[l], pb[(l + 1) % 3]));
+          }
+        }
+      }
+      result.smallestDistance = std::min(result.smallestDistance, d);
+    }
+  }
+  return result;
+}
+
+/** Flat coordinates and triangles of a mesh. */
+void
+Flatten(const MeshType * mesh, std::vector<double> & x, std::vector<uint32_t> & triangles)
+{
+  x.clear();
+  for (auto it = mesh->GetPoints()->Begin(); it != mesh->GetPoints()->End(); ++it)
+  {
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      x.push_back(it.Value()[k]);
+    }
+  }
+  itk::SurfaceCollision::ExtractTriangles(mesh, triangles);
+}
+} // namespace
+
+// ---------------------------------------------------------------------------
+// Known configurations.
+
+TEST(SurfaceCollision, ParallelTrianglesAtDistanceDGiveDExactly)
+{
+  const Triangle a = { { 0, 0, 0 }, { 4, 0, 0 }, { 0, 4, 0 } };
+  for (const double d : { 0.25, 0.1, 1.0 / 3.0, 7.5 })
+  {
+    // Overlapping in projection: the closest points are interior to a face.
+    const Triangle b = { { 0.5, 0.5, d }, { 2.5, 0.5, d }, { 0.5, 2.5, d } };
+    EXPECT_EQ(Distance(a, b), d);
+    EXPECT_FALSE(Intersect(a, b));
+    // The same plane, reversed orientation, shifted: still d.
+    const Triangle c = { { 1, 1, -d }, { 1, 3, -d }, { 3, 1, -d } };
+    EXPECT_EQ(Distance(a, c), d);
+  }
+}
+
+TEST(SurfaceCollision, EdgeThroughFaceIntersects)
+{
+  const Triangle a = { { 0, 0, 0 }, { 4, 0, 0 }, { 0, 4, 0 } };
+  // b pierces a: one vertex below, two above, crossing inside a.
+  const Triangle b = { { 1, 1, -1 }, { 1, 1, 1 }, { 1.5, 1.2, 1 } };
+  EXPECT_TRUE(Intersect(a, b));
+  EXPECT_EQ(Distance(a, b), 0.0);
+  // The same shifted beyond a's hypotenuse x + y = 4: no contact, distance
+  // from the edge (1.5+s, 1.2+s) ... the nearest vertex-edge pair.
+  const Triangle c = { { 3, 3, -1 }, { 3, 3, 1 }, { 3.5, 3.2, 1 } };
+  EXPECT_FALSE(Intersect(a, c));
+  // Closest: the segment x = y = 3 to the edge x + y = 4 at (2, 2, 0): sqrt 2.
+  EXPECT_NEAR(Distance(a, c), std::sqrt(2.0), 1e-15);
+  // Two triangles linked like chain links: each pierces the other.
+  const Triangle d = { { -1, 0, 0 }, { 1, 0, 0 }, { 0, 2, 0 } };
+  const Triangle e = { { 0, 1, -1 }, { 0, 1, 1 }, { 0, -1, 0.2 } };
+  EXPECT_TRUE(Intersect(d, e));
+}
+
+TEST(SurfaceCollision, TouchingTrianglesIntersect)
+{
+  const Triangle a = { { 0, 0, 0 }, { 4, 0, 0 }, { 0, 4, 0 } };
+  // A vertex of b on a's face.
+  const Triangle b = { { 1, 1, 0 }, { 1, 1, 2 }, { 2, 1, 2 } };
+  EXPECT_TRUE(Intersect(a, b));
+  EXPECT_EQ(Distance(a, b), 0.0);
+  // An edge of b on a's edge (collinear overlap), b out of a's plane.
+  const Triangle c = { { 1, 0, 0 }, { 3, 0, 0 }, { 2, -1, 1 } };
+  EXPECT_TRUE(Intersect(a, c));
+  // Vertex to vertex.
+  const Triangle e = { { 4, 0, 0 }, { 5, 1, 1 }, { 5, -1, 1 } };
+  EXPECT_TRUE(Intersect(a, e));
+  // Lifted by 1e-9: apart, and the distance says so.
+  const Triangle f = { { 1, 1, 1e-9 }, { 1, 1, 2 }, { 2, 1, 2 } };
+  EXPECT_FALSE(Intersect(a, f));
+  EXPECT_EQ(Distance(a, f), 1e-9);
+}
+
+TEST(SurfaceCollision, CoplanarTriangles)
+{
+  const Triangle a = { { 0, 0, 0 }, { 4, 0, 0 }, { 0, 4, 0 } };
+  // Overlapping edges.
+  const Triangle b = { { 1, 1, 0 }, { 5, 1, 0 }, { 1, 5, 0 } };
+  EXPECT_TRUE(Intersect(a, b));
+  EXPECT_EQ(Distance(a, b), 0.0);
+  // b inside a, no edge crossing.
+  const Triangle c = { { 0.5, 0.5, 0 }, { 1.5, 0.5, 0 }, { 0.5, 1.5, 0 } };
+  EXPECT_TRUE(Intersect(a, c));
+  EXPECT_TRUE(Intersect(c, a));
+  // Apart in the plane by 1 along x (vertex (5, 0) to a's vertex (4, 0)).
+  const Triangle e = { { 5, 0, 0 }, { 7, 0, 0 }, { 5, 2, 0 } };
+  EXPECT_FALSE(Intersect(a, e));
+  EXPECT_EQ(Distance(a, e), 1.0);
+  // Across the hypotenuse: (3, 3) to the line x + y = 4 is sqrt(2).
+  const Triangle g = { { 3, 3, 0 }, { 5, 3, 0 }, { 3, 5, 0 } };
+  EXPECT_FALSE(Intersect(a, g));
+  EXPECT_NEAR(Distance(a, g), std::sqrt(2.0), 1e-15);
+}
+
+TEST(SurfaceCollision, SkewEdgesGiveTheLineDistance)
+{
+  // Edges x in [-1, 1] at (y, z) = (0, 0) and y in [-1, 1] at x = 0, z = h:
+  // the closest points are the edges' midpoints, h apart.
+  const double   h = 0.375;
+  const Triangle a = { { -1, 0, 0 }, { 1, 0, 0 }, { 0, 0, -2 } };
+  const Triangle b = { { 0, -1, h }, { 0, 1, h }, { 0, 0, h + 2 } };
+  EXPECT_FALSE(Intersect(a, b));
+  EXPECT_EQ(Distance(a, b), h);
+}
+
+TEST(SurfaceCollision, DistanceAgreesWithTheIndependentCode)
+{
+  // Random pairs: the component's distance and intersection test against
+  // the brute-force helpers of this file.
+  std::mt19937                           random(7);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  unsigned int                           crossings = 0;
+  for (unsigned int trial = 0; trial < 20000; ++trial)
+  {
+    Triangle a(3), b(3);
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      for (unsigned int c = 0; c < 3; ++c)
+      {
+        a[k][c] = uniform(random);
+        b[k][c] = uniform(random) + 0.5;
+      }
+    }
+    bool hit = false;
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      hit = hit || SegmentHitsTriangle(a[k], a[(k + 1) % 3], b[0], b[1], b[2]) ||
+            SegmentHitsTriangle(b[k], b[(k + 1) % 3], a[0], a[1], a[2]);
+    }
+    ASSERT_EQ(Intersect(a, b), hit) << "trial " << trial;
+    crossings += hit;
+    if (!hit)
+    {
+      double d = std::numeric_limits<double>::infinity();
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        d = std::min({ d, PointTriangle(a[k], b[0], b[1], b[2]), PointTriangle(b[k], a[0], a[1], a[2]) });
+        for (unsigned int l = 0; l < 3; ++l)
+        {
+          d = std::min(d, SegmentSegment(a[k], a[(k + 1) % 3], b[l], b[(l + 1) % 3]));
+        }
+      }
+      ASSERT_NEAR(Distance(a, b), d, 1e-12) << "trial " << trial;
+    }
+  }
+  EXPECT_GT(crossings, 1000u) << "both outcomes are exercised";
+  EXPECT_LT(crossings, 19000u);
+}
+
+// ---------------------------------------------------------------------------
+// The index.
+
+TEST(SurfaceCollision, CountsTheIntersectionsOfTwoOverlappingSpheres)
+{
+  // Two spheres of radius 5, centres about 6 apart: they cross along a
+  // circle. (Off the axes: with centres (0, 0, 0) and (6, 0, 0) the meshes
+  // are mirror images and some pairs touch exactly along edges, where the
+  // outcome of any floating-point test is the rounding's.)
+  MeshType::PointType c1, c2;
+  c1.Fill(0.0);
+  c2[0] = 6.0;
+  c2[1] = 0.23;
+  c2[2] = 0.17;
+  const auto            one = itk::MakeSphereMesh<MeshType>(c1, 5.0, 3);
+  const auto            two = itk::MakeSphereMesh<MeshType>(c2, 5.0, 3);
+  std::vector<double>   x, x2;
+  std::vector<uint32_t> t, t2;
+  Flatten(one, x, t);
+  Flatten(two, x2, t2);
+  EXPECT_EQ(itk::SurfaceCollision::CountSelfIntersections(x.data(), t.data(), t.size() / 3), 0u);
+  EXPECT_EQ(itk::SurfaceCollision::CountSelfIntersections(one.GetPointer()), 0u);
+  const auto offset = static_cast<uint32_t>(x.size() / 3);
+  x.insert(x.end(), x2.begin(), x2.end());
+  for (const uint32_t v : t2)
+  {
+    t.push_back(v + offset);
+  }
+  std::pair<itk::SizeValueType, itk::SizeValueType> first;
+  const itk::SizeValueType                          count =
+    itk::SurfaceCollision::CountSelfIntersections(x.data(), t.data(), t.size() / 3, &first);
+  const BruteForce all = CheckAllPairs(x, t, 0.0);
+  EXPECT_GT(count, 20u);
+  EXPECT_EQ(count, all.intersecting) << "the grid finds every pair the all-pairs test finds";
+  EXPECT_LT(first.first, first.second);
+  EXPECT_GE(first.second, t2.size() / 3) << "one triangle of each sphere";
+  // Apart (centres more than 10.5 apart): none.
+  for (std::size_t i = offset; i < x.size() / 3; ++i)
+  {
+    x[3 * i] += 4.5;
+  }
+  EXPECT_EQ(itk::SurfaceCollision::CountSelfIntersections(x.data(), t.data(), t.size() / 3), 0u);
+}
+
+TEST(SurfaceCollision, ConstrainStopsFrontsPushedThroughEachOther)
+{
+  // Two parallel sheets 2 apart (triangulated squares), each pushed 1.6 toward
+  // the other in one step, with a few vertices pushed further: without the
+  // constraint they cross; constrained, none intersects and no pair is
+  // closer than d, nor did the sheets move where they are clear.
+  const unsigned int    m = 12;
+  std::vector<double>   x;
+  std::vector<uint32_t> triangles;
+  for (unsigned int sheet = 0; sheet < 2; ++sheet)
+  {
+    const auto base = static_cast<uint32_t>(x.size() / 3);
+    for (unsigned int j = 0; j <= m; ++j)
+    {
+      for (unsigned int i = 0; i <= m; ++i)
+      {
+        x.push_back(0.5 * i + (sheet ? 0.13 : 0.0));
+        x.push_back(0.5 * j + (sheet ? 0.07 : 0.0));
+        x.push_back(sheet ? 2.0 : 0.0);
+      }
+    }
+    for (unsigned int j = 0; j < m; ++j)
+    {
+      for (unsigned int i = 0; i < m; ++i)
+      {
+        const uint32_t p = base + j * (m + 1) + i;
+        triangles.insert(triangles.end(), { p, p + 1, p + m + 2, p, p + m + 2, p + m + 1 });
+      }
+    }
+  }
+  const std::size_t   n = x.size() / 3;
+  std::vector<double> y = x;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const bool   upper = i >= n / 2;
+    const double px = x[3 * i] - 3.0, py = x[3 * i + 1] - 3.0;
+    // A bump: up to 1.2 toward the other sheet at the centre, 0 at the rim.
+    const double push = 1.2 * std::max(0.0, 1.0 - (px * px + py * py) / 6.0);
+    y[3 * i + 2] += upper ? -push : push;
+    y[3 * i] += 0.01; // everything moves a little
+  }
+  EXPECT_GT(CheckAllPairs(y, triangles, 0.0).intersecting, 0u) << "unconstrained, the fronts cross";
+
+  const double          d = 0.3;
+  itk::SurfaceCollision collision;
+  collision.SetSurface(n, triangles.data(), triangles.size() / 3);
+  const auto result = collision.Constrain(x.data(), y.data(), d, nullptr, 1);
+  EXPECT_TRUE(result.rebuilt);
+  EXPECT_GT(result.violations, 0u);
+  EXPECT_GT(result.constrained, 0u);
+  EXPECT_EQ(result.constrained, collision.GetConstrainedPoints().size());
+  const BruteForce after = CheckAllPairs(y, triangles, d);
+  EXPECT_EQ(after.intersecting, 0u);
+  EXPECT_GE(after.smallestDistance, d);
+  // Points away from the bump (push 0) kept their displacement unless the
+  // constraint reduced it: the rim moved by exactly 0.01 along x.
+  EXPECT_EQ(y[0], x[0] + 0.01);
+  EXPECT_EQ(y[2], x[2]);
+
+  // A second step from the constrained state: the same push again, with the
+  // index kept (nothing left its skin): still clear.
+  std::vector<double> x2 = y;
+  std::vector<double> y2 = y;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    y2[3 * i + 2] += (i >= n / 2) ? -0.2 : 0.2;
+  }
+  collision.Constrain(x2.data(), y2.data(), d, nullptr, 1);
+  const BruteForce second = CheckAllPairs(y2, triangles, d);
+  EXPECT_EQ(second.intersecting, 0u);
+  EXPECT_GE(second.smallestDistance, d);
+}
