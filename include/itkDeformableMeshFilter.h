@@ -59,6 +59,31 @@ namespace itk
  * MaximumStepLength, when positive, bounds the length of each vertex's
  * displacement per iteration.
  *
+ * Resolution: \f$ E_i \f$ and \f$ R_i \f$ are umbrella operators of the mesh's
+ * edges, about \f$ (h^2/4)\,\Delta x \f$ and \f$ -(h^4/16)\,\Delta^2 x \f$ on
+ * edges of length \f$ h \f$ (\f$ \Delta x = -2Hn \f$, the mean curvature
+ * vector): with the same Elasticity and Rigidity a finer mesh is much less
+ * regularised. With ReferenceEdgeLength \f$ L > 0 \f$ (mm) they are weighted
+ * by \f$ w = L^2 / \langle h^2 \rangle \f$ and \f$ w^2 \f$, \f$ \langle h^2
+ * \rangle \f$ the mesh's mean squared edge length at the start of each
+ * iteration (GetEdgeWeight()): curvature terms in physical units,
+ * \f$ a (L^2/4) \Delta x \f$ and \f$ -b (L^4/16) \Delta^2 x \f$ mm per
+ * iteration, which produce the same surface at any resolution, Elasticity
+ * and Rigidity being the weights the terms have on a mesh of edge length L.
+ * The explicit update then needs \f$ a w + 2 b w^2 \le 1 \f$: on edges
+ * shorter than L an iteration is split into sub-steps of the internal forces
+ * (about \f$ 2b(L/h)^4 \f$ of them; GetNumberOfSubSteps()), which costs time
+ * but not accuracy; the external force and the balloon act once per
+ * iteration, so the surface moves toward the object at the same speed at any
+ * resolution. The weight is one for the whole mesh, not per vertex: the
+ * umbrella operators are averages, so the bound then does not depend on the
+ * shortest edges, which a deformation without remeshing shrinks to a
+ * fraction of the mean (per-vertex weights would make the number of
+ * sub-steps follow them); on a mesh of very uneven edge lengths the regions
+ * of short edges are regularised less than the others. The balloon, ScaleFactor (with a normalised force field),
+ * MaximumStepLength and ConvergenceTolerance are in mm per iteration and
+ * mean the same at any resolution in both modes.
+ *
  * With the output of ExternalForceImageFilter (normalised so that the largest
  * force has length 1), ScaleFactor is the largest external displacement per
  * iteration in physical units, whatever the intensity range of the image.
@@ -241,9 +266,42 @@ public:
   itkGetConstMacro(ObjectIntensityUpper, double);
   itkGetConstMacro(ObjectIntensityWidth, double);
 
+  /** Reference edge length L, physical units (mm): the edge length at which
+   * Elasticity and Rigidity have their nominal weight. When positive the
+   * internal forces are scaled at each vertex by (L/h)^2 (elasticity) and
+   * (L/h)^4 (rigidity),
+   * so that the same parameters produce the same surface whatever the mesh's
+   * resolution (h the mesh's root mean square edge length at each
+   * iteration); an iteration on edges shorter than L is split into
+   * sub-steps of the internal forces (see the class documentation and
+   * GetNumberOfSubSteps()). Typically the target edge length of the mesh
+   * (for example the voxel size). 0: no scaling, the weights are relative to
+   * the mesh's own edges (the established behaviour, which depends on the
+   * resolution). Must be finite and non-negative. Default: 0. */
+  itkSetMacro(ReferenceEdgeLength, double);
+  itkGetConstMacro(ReferenceEdgeLength, double);
+
+  /** Largest number of sub-steps of the internal forces an iteration may
+   * take with ReferenceEdgeLength > 0; an update that would need more stops
+   * with an exception saying so (a reference length far above the mesh's
+   * edge lengths). At least 1. Default: 1000. */
+  itkSetClampMacro(MaximumNumberOfSubSteps, unsigned int, 1, NumericTraits<unsigned int>::max());
+  itkGetConstMacro(MaximumNumberOfSubSteps, unsigned int);
+
+  /** Sub-steps of the internal forces at the last iteration: 1 without
+   * ReferenceEdgeLength, else the smallest m >= 1 with
+   * (a w + 2 b w^2) / m <= 1. */
+  itkGetConstMacro(NumberOfSubSteps, unsigned int);
+
+  /** Edge weight w = (L / h)^2 of the last iteration, h the root mean square
+   * edge length of the mesh at its start: the factor applied to Elasticity
+   * (w^2 to Rigidity). 1 without ReferenceEdgeLength. */
+  itkGetConstMacro(EdgeWeight, double);
+
   /** Upper bound on the length of a vertex's displacement per iteration, in
-   * physical units; 0 means no bound. Useful with raw (unnormalised) force
-   * fields. Must be finite and non-negative. Default: 0. */
+   * physical units (per sub-step when an iteration has several, see
+   * ReferenceEdgeLength); 0 means no bound. Useful with raw (unnormalised)
+   * force fields. Must be finite and non-negative. Default: 0. */
   itkSetMacro(MaximumStepLength, double);
   itkGetConstMacro(MaximumStepLength, double);
 
@@ -267,7 +325,9 @@ public:
 
   /** Per-vertex diagnostics of the last iteration, indexed by point
    * identifier, physical units: displacement length, external force
-   * contribution s|F| and internal force contribution |aE + bR|. Empty before
+   * contribution s|F| and internal force contribution |aE + bR| (with
+   * sub-steps: the whole iteration's displacement, and the internal force
+   * per iteration at the last sub-step). Empty before
    * the first iteration. They are computed at the iterations that may end an
    * update (the last one scheduled, one that can complete convergence) and at
    * every iteration when the filter has an IterationEvent or ProgressEvent
@@ -361,6 +421,10 @@ private:
   double       m_Rigidity{ 0.0 };
   double       m_Balloon{ 0.0 };
   double       m_MaximumStepLength{ 0.0 };
+  double       m_ReferenceEdgeLength{ 0.0 };
+  unsigned int m_MaximumNumberOfSubSteps{ 1000 };
+  unsigned int m_NumberOfSubSteps{ 1 };
+  double       m_EdgeWeight{ 1.0 };
   double       m_RegionWeight{ 0.0 };
   double       m_RegionSigma{ 1.0 };
   double       m_IntensityTolerance{ 2.2 };
@@ -402,7 +466,8 @@ private:
   std::vector<float>   m_Umbrella;
   std::vector<float>   m_Normals;
   std::vector<uint8_t> m_BalloonReleased;
-  std::vector<float>   m_NormalSpeeds; // image terms only
+  std::vector<float>   m_NormalSpeeds;   // image terms only
+  std::vector<double>  m_IterationStart; // coordinates at the start of an iteration of several sub-steps
 
   // Image terms: the smoothed intensity image (kept while the input image and
   // RegionSigma are unchanged), its sampler and the object's model.

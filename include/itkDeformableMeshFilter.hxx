@@ -20,6 +20,7 @@
 
 #include "itkDeformableMeshFilter.h"
 #include "itkDeformableMeshFilterKernels.h"
+#include "itkDeformableMeshUpdateRule.h"
 #include "itkMultiThreaderBase.h"
 
 #include <algorithm>
@@ -62,6 +63,11 @@ DeformableMeshFilter<TMesh, TForceImage>::VerifyPreconditions() const
   if (!std::isfinite(m_Balloon))
   {
     itkExceptionMacro("Balloon must be finite; it is " << m_Balloon << ".");
+  }
+  if (!(m_ReferenceEdgeLength >= 0.0 && std::isfinite(m_ReferenceEdgeLength)))
+  {
+    itkExceptionMacro("ReferenceEdgeLength must be finite and non-negative (0: the mesh's own edges); it is "
+                      << m_ReferenceEdgeLength << ".");
   }
   if (!(m_MaximumStepLength >= 0.0 && std::isfinite(m_MaximumStepLength)))
   {
@@ -446,9 +452,11 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
 
   const bool useElasticity = m_Elasticity > 0.0;
   // Image terms (region force, edge search) need the current unit normals
-  // before the step: the geometry pass stores them, as for rigidity.
+  // before the step: the geometry pass stores them, as for rigidity. With a
+  // reference edge length the geometry pass also gives the edge weights.
   const bool useImageTerms = this->UsesImageTerms();
-  const bool useRigidity = m_Rigidity > 0.0 || useImageTerms;
+  const bool scaled = m_ReferenceEdgeLength > 0.0 && (useElasticity || m_Rigidity > 0.0);
+  const bool useRigidity = m_Rigidity > 0.0 || useImageTerms || scaled;
   const bool useNormal = m_Balloon != 0.0 || (useElasticity && m_TangentialElasticity) || useImageTerms;
 
   if (m_DisplacementMagnitudes.size() != numberOfPoints)
@@ -492,11 +500,11 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
       m_Normals.assign(4 * numberOfPoints, 0.0f);
     }
   }
-  const MeshTables mesh{ m_NeighbourOffsets.data(), m_Neighbours.data(),
+  const MeshTables    mesh{ m_NeighbourOffsets.data(), m_Neighbours.data(),
                          m_RingKinds.data(),        m_GeneralVertices.data(),
                          m_GeneralVertices.size(),  m_GeneralPairOffsets.data(),
                          m_GeneralPairs.data(),     ordered ? m_ValenceOrder.data() : nullptr };
-  StepArrays       arrays{ coordinates.data(),
+  StepArrays          arrays{ coordinates.data(),
                      m_NextCoordinates.data(),
                      m_Umbrella.data(),
                      m_Normals.data(),
@@ -505,18 +513,110 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
                      m_DisplacementMagnitudes.data(),
                      m_ExternalForceMagnitudes.data(),
                      m_InternalForceMagnitudes.data() };
-  if (useRigidity)
-  {
+  std::vector<double> blockMaximum(numberOfBlocks, 0.0);
+  // The geometry pass; returns the mean squared edge length of the vertices
+  // that have neighbours when scaled, else 0.
+  const auto geometryPass = [&](bool needLengths) {
     const double orientationSign = m_OrientationSign;
     threader->ParallelizeArray(
       0,
       numberOfBlocks,
       [&](SizeValueType block) {
         const SizeValueType begin = block * BlockSize;
-        RunGeometryBlock(
-          path, useNormal, ordered, mesh, arrays, orientationSign, begin, std::min(numberOfPoints, begin + BlockSize));
+        blockMaximum[block] = RunGeometryBlock(path,
+                                               useNormal,
+                                               ordered,
+                                               needLengths,
+                                               mesh,
+                                               arrays,
+                                               orientationSign,
+                                               begin,
+                                               std::min(numberOfPoints, begin + BlockSize));
       },
       nullptr);
+    if (!needLengths)
+    {
+      return 0.0;
+    }
+    double        sum = 0.0;
+    SizeValueType connected = 0;
+    for (const double blockSum : blockMaximum)
+    {
+      sum += blockSum;
+    }
+    for (SizeValueType i = 0; i < numberOfPoints; ++i)
+    {
+      connected += m_NeighbourOffsets[i + 1] > m_NeighbourOffsets[i];
+    }
+    return connected > 0 ? sum / static_cast<double>(connected) : 0.0;
+  };
+  const auto stepPass = [&](const StepTerms & terms, bool diagnoseStep) {
+    threader->ParallelizeArray(
+      0,
+      numberOfBlocks,
+      [&](SizeValueType block) {
+        const SizeValueType begin = block * BlockSize;
+        blockMaximum[block] = RunStepBlock(path,
+                                           useRigidity,
+                                           useNormal,
+                                           ordered,
+                                           m_Sampler,
+                                           mesh,
+                                           terms,
+                                           arrays,
+                                           begin,
+                                           std::min(numberOfPoints, begin + BlockSize),
+                                           diagnoseStep);
+      },
+      nullptr);
+  };
+
+  // Stability of the explicit internal update: without a reference edge
+  // length a + 2b <= 1, larger sums scaled; with one, the weights a w and
+  // b w^2 (w the edge weight of the mesh at the start of the iteration) in as
+  // many sub-steps of the internal forces as a w + 2 b w^2 <= 1 needs
+  // (DeformableMeshUpdateRule::FromParameters()).
+  double edgeWeight = 0.0;
+  if (useRigidity)
+  {
+    const double meanSquaredEdgeLength = geometryPass(scaled);
+    edgeWeight = DeformableMeshUpdateRule::EdgeWeight(scaled ? m_ReferenceEdgeLength : 0.0, meanSquaredEdgeLength);
+  }
+  const DeformableMeshUpdateRule rule = DeformableMeshUpdateRule::FromParameters(
+    m_ScaleFactor, m_Elasticity, m_Rigidity, m_TangentialElasticity, m_Balloon, m_MaximumStepLength, edgeWeight);
+  m_EdgeWeight = scaled ? edgeWeight : 1.0;
+  if (rule.subSteps > m_MaximumNumberOfSubSteps)
+  {
+    itkExceptionMacro("ReferenceEdgeLength " << m_ReferenceEdgeLength << " mm with Elasticity " << m_Elasticity
+                                             << " and Rigidity " << m_Rigidity << " needs " << rule.subSteps
+                                             << " sub-steps per iteration on this mesh (root mean square edge length "
+                                             << m_ReferenceEdgeLength / std::sqrt(edgeWeight)
+                                             << " mm), more than MaximumNumberOfSubSteps (" << m_MaximumNumberOfSubSteps
+                                             << "): lower ReferenceEdgeLength, Elasticity or Rigidity, or use a "
+                                                "coarser mesh.");
+  }
+  m_NumberOfSubSteps = static_cast<unsigned int>(rule.subSteps);
+  if (m_NumberOfSubSteps > 1)
+  {
+    // The internal forces alone for all sub-steps but the last; the
+    // displacement of the iteration is measured from where it started.
+    m_IterationStart.assign(coordinates.begin(), coordinates.end());
+    const DeformableMeshUpdateRule internal = rule.InternalOnly();
+    const StepTerms                internalTerms{ internal.scaleFactor, internal.elasticity, internal.rigidity,
+                                   internal.tangential,  internal.balloon,    internal.maximumStepLength,
+                                   m_OrientationSign };
+    for (unsigned int k = 1; k < m_NumberOfSubSteps; ++k)
+    {
+      stepPass(internalTerms, false);
+      coordinates.swap(m_NextCoordinates);
+      arrays.coordinates = coordinates.data();
+      arrays.next = m_NextCoordinates.data();
+      geometryPass(false);
+    }
+  }
+  else
+  {
+    std::vector<double>().swap(m_IterationStart);
   }
   if (useImageTerms)
   {
@@ -528,33 +628,35 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
     m_NormalSpeeds.clear();
   }
 
-  // Stability of the explicit internal update requires a + 2b <= 1: larger
-  // sums are scaled.
-  const double    internalSum = m_Elasticity + 2.0 * m_Rigidity;
-  const double    internalScale = internalSum > 1.0 ? 1.0 / internalSum : 1.0;
-  const StepTerms terms{
-    m_ScaleFactor, m_Elasticity * internalScale, m_Rigidity * internalScale, m_TangentialElasticity,
-    m_Balloon,     m_MaximumStepLength,          m_OrientationSign
-  };
-  std::vector<double> blockMaximum(numberOfBlocks, 0.0);
-  threader->ParallelizeArray(
-    0,
-    numberOfBlocks,
-    [&](SizeValueType block) {
-      const SizeValueType begin = block * BlockSize;
-      blockMaximum[block] = RunStepBlock(path,
-                                         useRigidity,
-                                         useNormal,
-                                         ordered,
-                                         m_Sampler,
-                                         mesh,
-                                         terms,
-                                         arrays,
-                                         begin,
-                                         std::min(numberOfPoints, begin + BlockSize),
-                                         diagnose);
-    },
-    nullptr);
+  const StepTerms terms{ rule.scaleFactor, rule.elasticity,        rule.rigidity,    rule.tangential,
+                         rule.balloon,     rule.maximumStepLength, m_OrientationSign };
+  stepPass(terms, diagnose);
+  if (m_NumberOfSubSteps > 1)
+  {
+    // The displacement of the whole iteration; the internal force of the
+    // last sub-step as a force per iteration (times the number of sub-steps).
+    const double * start = m_IterationStart.data();
+    const double * end = m_NextCoordinates.data();
+    double         largest = 0.0;
+    for (SizeValueType i = 0; i < numberOfPoints; ++i)
+    {
+      const double d[3] = { end[3 * i] - start[3 * i],
+                            end[3 * i + 1] - start[3 * i + 1],
+                            end[3 * i + 2] - start[3 * i + 2] };
+      const double squared = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+      largest = std::max(largest, squared);
+      if (diagnose)
+      {
+        m_DisplacementMagnitudes[i] = static_cast<float>(std::sqrt(squared));
+        m_InternalForceMagnitudes[i] *= static_cast<float>(m_NumberOfSubSteps);
+      }
+    }
+    std::fill(blockMaximum.begin(), blockMaximum.end(), 0.0);
+    if (numberOfBlocks > 0)
+    {
+      blockMaximum[0] = std::sqrt(largest);
+    }
+  }
 
   coordinates.swap(m_NextCoordinates);
 
@@ -585,6 +687,10 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "EstimateObjectIntensityRange: " << m_EstimateObjectIntensityRange << std::endl;
   os << indent << "ObjectIntensityRange: [" << m_ObjectIntensityLower << ", " << m_ObjectIntensityUpper << "], width "
      << m_ObjectIntensityWidth << std::endl;
+  os << indent << "ReferenceEdgeLength: " << m_ReferenceEdgeLength << std::endl;
+  os << indent << "MaximumNumberOfSubSteps: " << m_MaximumNumberOfSubSteps << std::endl;
+  os << indent << "NumberOfSubSteps: " << m_NumberOfSubSteps << std::endl;
+  os << indent << "EdgeWeight: " << m_EdgeWeight << std::endl;
   os << indent << "MaximumStepLength: " << m_MaximumStepLength << std::endl;
   os << indent << "ConvergenceTolerance: " << m_ConvergenceTolerance << std::endl;
   os << indent << "ConvergenceWindow: " << m_ConvergenceWindow << std::endl;

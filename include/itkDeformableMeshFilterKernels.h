@@ -104,38 +104,49 @@ namespace AVX2FMA
 #  endif
 #endif
 
-/** The geometry pass of a work block on \a path. */
-inline void
+/** The geometry pass of a work block on \a path; returns, when \a needLengths,
+ * the sum of its vertices' mean squared edge lengths, else 0 (see
+ * GeometryBlock()). */
+inline double
 RunGeometryBlock(KernelPath         path,
                  bool               needNormal,
                  bool               ordered,
+                 bool               needLengths,
                  const MeshTables & mesh,
                  const StepArrays & arrays,
                  double             orientationSign,
                  SizeValueType      begin,
                  SizeValueType      end)
 {
+  double squaredEdgeSum = 0.0;
   WithConstant(needNormal, [&](auto normal) {
     WithConstant(ordered, [&](auto inOrder) {
-      constexpr bool NeedNormal = decltype(normal)::value;
-      constexpr bool Ordered = decltype(inOrder)::value;
-      switch (path)
-      {
+      WithConstant(needLengths, [&](auto withLengths) {
+        constexpr bool NeedNormal = decltype(normal)::value;
+        constexpr bool Ordered = decltype(inOrder)::value;
+        constexpr bool NeedLengths = decltype(withLengths)::value;
+        switch (path)
+        {
 #if EDM_KERNELS_AVX2
-        case KernelPath::AVX2FMA:
-          AVX2FMA::GeometryBlock<NeedNormal, Ordered>(mesh, arrays, orientationSign, begin, end);
-          return;
+          case KernelPath::AVX2FMA:
+            squaredEdgeSum =
+              AVX2FMA::GeometryBlock<NeedNormal, Ordered, NeedLengths>(mesh, arrays, orientationSign, begin, end);
+            return;
 #endif
 #if EDM_KERNELS_SSE2
-        case KernelPath::SSE2:
-          SSE2::GeometryBlock<NeedNormal, Ordered>(mesh, arrays, orientationSign, begin, end);
-          return;
+          case KernelPath::SSE2:
+            squaredEdgeSum =
+              SSE2::GeometryBlock<NeedNormal, Ordered, NeedLengths>(mesh, arrays, orientationSign, begin, end);
+            return;
 #endif
-        default:
-          Portable::GeometryBlock<NeedNormal, Ordered>(mesh, arrays, orientationSign, begin, end);
-      }
+          default:
+            squaredEdgeSum =
+              Portable::GeometryBlock<NeedNormal, Ordered, NeedLengths>(mesh, arrays, orientationSign, begin, end);
+        }
+      });
     });
   });
+  return squaredEdgeSum;
 }
 
 /** The step of a work block on \a path; returns its largest displacement. */

@@ -34,6 +34,8 @@
 #include <cstring>
 #include <array>
 #include <cstdint>
+#include <limits>
+#include <string>
 #include <map>
 #include <set>
 #include <vector>
@@ -219,15 +221,31 @@ MakeForceImage()
   return image;
 }
 
+struct TermSet
+{
+  const char * name;
+  double       scaleFactor;
+  double       elasticity;
+  bool         tangential;
+  double       rigidity;
+  double       balloon;
+  double       maximumStep;
+  double       referenceEdgeLength; // mm; 0: none (the weights of the mesh's own edges)
+};
+
 /** The scalar reference step: the mesh's neighbours and triangles read from
  * its cells, the force by ITK's linear interpolation, each vertex's
- * displacement by DeformableMeshUpdateRule. */
+ * displacement by DeformableMeshUpdateRule; with a reference edge length, the
+ * edge weight from the mean over the vertices that have neighbours of their
+ * edges' mean squared length at the start of the iteration, and as many
+ * sub-steps as the rule says, the external force and the balloon in the
+ * last. */
 class ReferenceStep
 {
 public:
-  ReferenceStep(const MeshType * mesh, const ForceImageType * forces, const RuleType & rule)
+  ReferenceStep(const MeshType * mesh, const ForceImageType * forces, const TermSet & terms)
     : m_Forces(forces)
-    , m_Rule(rule)
+    , m_Terms(terms)
   {
     const auto n = mesh->GetNumberOfPoints();
     m_Neighbours.resize(n);
@@ -271,8 +289,48 @@ public:
     m_Interpolator->SetInputImage(forces);
   }
 
-  void
+  /** One iteration; returns its number of sub-steps. */
+  double
   Step()
+  {
+    double weight = 0.0;
+    if (m_Terms.referenceEdgeLength > 0.0)
+    {
+      double      sum = 0.0;
+      std::size_t connected = 0;
+      for (std::size_t i = 0; i < m_X.size(); ++i)
+      {
+        if (m_Neighbours[i].empty())
+        {
+          continue;
+        }
+        double squares = 0.0;
+        for (const auto j : m_Neighbours[i])
+        {
+          squares += (m_X[j] - m_X[i]).GetSquaredNorm();
+        }
+        sum += squares / static_cast<double>(m_Neighbours[i].size());
+        ++connected;
+      }
+      weight = RuleType::EdgeWeight(m_Terms.referenceEdgeLength, sum / static_cast<double>(connected));
+    }
+    const RuleType rule = RuleType::FromParameters(m_Terms.scaleFactor,
+                                                   m_Terms.elasticity,
+                                                   m_Terms.rigidity,
+                                                   m_Terms.tangential,
+                                                   m_Terms.balloon,
+                                                   m_Terms.maximumStep,
+                                                   weight);
+    for (double k = 1.0; k < rule.subSteps; k += 1.0)
+    {
+      SubStep(rule.InternalOnly());
+    }
+    SubStep(rule);
+    return rule.subSteps;
+  }
+
+  void
+  SubStep(const RuleType & rule)
   {
     const std::size_t       n = m_X.size();
     std::vector<VectorType> umbrella(n);
@@ -296,7 +354,7 @@ public:
       v.normal = normal[i];
       v.umbrellaMean = Umbrella(umbrella, i) + umbrella[i];
       bool released = m_Released[i];
-      next[i] = m_X[i] + m_Rule.Displacement(v, released);
+      next[i] = m_X[i] + rule.Displacement(v, released);
       m_Released[i] = released;
     }
     m_X = next;
@@ -369,7 +427,7 @@ private:
 
   using InterpolatorType = itk::VectorLinearInterpolateImageFunction<ForceImageType, double>;
   const ForceImageType *                                             m_Forces;
-  RuleType                                                           m_Rule;
+  TermSet                                                            m_Terms;
   std::vector<VectorType>                                            m_X;
   std::vector<std::set<MeshType::PointIdentifier>>                   m_Neighbours;
   std::vector<std::vector<std::array<MeshType::PointIdentifier, 2>>> m_Triangles;
@@ -378,31 +436,33 @@ private:
   InterpolatorType::Pointer                                          m_Interpolator{ InterpolatorType::New() };
 };
 
-struct TermSet
-{
-  const char * name;
-  double       scaleFactor;
-  double       elasticity;
-  bool         tangential;
-  double       rigidity;
-  double       balloon;
-  double       maximumStep;
-};
-
-// Each term alone, then together; Elasticity + 2 Rigidity above 1 once (scaled).
+// Each term alone, then together; Elasticity + 2 Rigidity above 1 once
+// (scaled); then with reference edge lengths (the irregular mesh's root mean
+// square edge length is about 1.1 mm): below it (weights below 1, one step),
+// and above it (several sub-steps). Not much above it with every term: the
+// elasticity shrinks the quadrilateral to a point within the 6 iterations,
+// whose normal is then the rounding of its triangles (single precision in the
+// kernels, double in the reference).
 const TermSet TermSets[] = {
-  { "external force only", 0.7, 0.0, true, 0.0, 0.0, 0.0 },
-  { "elasticity, full umbrella", 0.5, 0.4, false, 0.0, 0.0, 0.0 },
-  { "elasticity, tangential", 0.5, 0.4, true, 0.0, 0.0, 0.0 },
-  { "rigidity", 0.5, 0.0, true, 0.3, 0.0, 0.0 },
-  { "balloon and its release", 0.6, 0.0, true, 0.0, 0.35, 0.0 },
-  { "step bound", 0.9, 0.0, true, 0.0, 0.0, 0.25 },
-  { "all terms", 0.6, 0.3, true, 0.2, 0.3, 0.4 },
-  { "all terms, a + 2b above 1", 0.6, 0.8, false, 0.4, -0.2, 0.5 },
+  { "external force only", 0.7, 0.0, true, 0.0, 0.0, 0.0, 0.0 },
+  { "elasticity, full umbrella", 0.5, 0.4, false, 0.0, 0.0, 0.0, 0.0 },
+  { "elasticity, tangential", 0.5, 0.4, true, 0.0, 0.0, 0.0, 0.0 },
+  { "rigidity", 0.5, 0.0, true, 0.3, 0.0, 0.0, 0.0 },
+  { "balloon and its release", 0.6, 0.0, true, 0.0, 0.35, 0.0, 0.0 },
+  { "step bound", 0.9, 0.0, true, 0.0, 0.0, 0.25, 0.0 },
+  { "all terms", 0.6, 0.3, true, 0.2, 0.3, 0.4, 0.0 },
+  { "all terms, a + 2b above 1", 0.6, 0.8, false, 0.4, -0.2, 0.5, 0.0 },
+  { "all terms, reference edge length 0.8 mm", 0.6, 0.5, true, 0.3, 0.3, 0.0, 0.8 },
+  { "full umbrella, reference edge length 3 mm (sub-steps)", 0.5, 0.4, false, 0.0, 0.0, 0.0, 3.0 },
+  { "all terms, reference edge length 1.4 mm (sub-steps)", 0.6, 0.2, true, 0.15, 0.2, 0.4, 1.4 },
 };
 
 std::vector<VectorType>
-RunFilter(const MeshType * mesh, const ForceImageType * forces, const TermSet & terms, unsigned int steps)
+RunFilter(const MeshType *       mesh,
+          const ForceImageType * forces,
+          const TermSet &        terms,
+          unsigned int           steps,
+          unsigned int *         subSteps = nullptr)
 {
   auto filter = FilterType::New();
   filter->SetInput(mesh);
@@ -413,8 +473,13 @@ RunFilter(const MeshType * mesh, const ForceImageType * forces, const TermSet & 
   filter->SetRigidity(terms.rigidity);
   filter->SetBalloon(terms.balloon);
   filter->SetMaximumStepLength(terms.maximumStep);
+  filter->SetReferenceEdgeLength(terms.referenceEdgeLength);
   filter->SetNumberOfIterations(steps);
   filter->Update();
+  if (subSteps != nullptr)
+  {
+    *subSteps = filter->GetNumberOfSubSteps();
+  }
   std::vector<VectorType> x;
   for (auto it = filter->GetOutput()->GetPoints()->Begin(); it != filter->GetOutput()->GetPoints()->End(); ++it)
   {
@@ -437,13 +502,16 @@ TEST(DeformableMeshFilterKernels, KernelsFollowTheScalarRuleOnIrregularMeshes)
   constexpr unsigned int steps = 6;
   for (const TermSet & terms : TermSets)
   {
-    const RuleType rule = RuleType::FromParameters(
-      terms.scaleFactor, terms.elasticity, terms.rigidity, terms.tangential, terms.balloon, terms.maximumStep);
-    ReferenceStep reference(mesh, forces, rule);
+    ReferenceStep reference(mesh, forces, terms);
+    double        lastSubSteps = 0.0;
+    double        mostSubSteps = 0.0;
     for (unsigned int k = 0; k < steps; ++k)
     {
-      reference.Step();
+      lastSubSteps = reference.Step();
+      mostSubSteps = std::max(mostSubSteps, lastSubSteps);
     }
+    // The cases of several sub-steps have them.
+    EXPECT_EQ(mostSubSteps > 1.0, std::strstr(terms.name, "sub-steps") != nullptr) << terms.name;
     for (const KernelPath path : AllPaths)
     {
       const KernelPathScope scope(path);
@@ -451,8 +519,10 @@ TEST(DeformableMeshFilterKernels, KernelsFollowTheScalarRuleOnIrregularMeshes)
       {
         continue;
       }
-      const auto x = RunFilter(mesh, forces, terms, steps);
+      unsigned int subSteps = 0;
+      const auto   x = RunFilter(mesh, forces, terms, steps, &subSteps);
       ASSERT_EQ(x.size(), reference.GetCoordinates().size());
+      EXPECT_EQ(subSteps, lastSubSteps) << terms.name;
       double largest = 0.0;
       double moved = 0.0;
       for (std::size_t i = 0; i < x.size(); ++i)
@@ -587,8 +657,8 @@ HashOf(const std::vector<VectorType> & x)
 }
 
 const TermSet LongRunTerms[] = {
-  { "all terms", 0.5, 0.3, true, 0.1, 0.15, 0.4 },
-  { "full umbrella and balloon", 0.5, 0.25, false, 0.0, 0.1, 0.0 },
+  { "all terms", 0.5, 0.3, true, 0.1, 0.15, 0.4, 0.0 },
+  { "full umbrella and balloon", 0.5, 0.25, false, 0.0, 0.1, 0.0, 0.0 },
 };
 // END 300-STEP CASE
 } // namespace
@@ -634,4 +704,55 @@ TEST(DeformableMeshFilterKernels, ThreeHundredStepsGiveTheBitsOfTheStepBeforeThe
 #endif
     }
   }
+}
+
+// ReferenceEdgeLength: bad values are refused by name; a reference length
+// that would need more sub-steps than allowed stops the update with an
+// exception that says how many and why, rather than running for hours.
+TEST(DeformableMeshFilterKernels, ReferenceEdgeLengthBadInputAndSubStepLimit)
+{
+  const auto mesh = MakeIrregularMesh();
+  const auto forces = MakeForceImage();
+  auto       filter = FilterType::New();
+  filter->SetInput(mesh);
+  filter->SetForceImage(forces);
+  filter->SetElasticity(0.3);
+  filter->SetRigidity(0.1);
+  filter->SetNumberOfIterations(2);
+  for (const double bad : { -1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity() })
+  {
+    filter->SetReferenceEdgeLength(bad);
+    try
+    {
+      filter->Update();
+      ADD_FAILURE() << "ReferenceEdgeLength " << bad << " accepted";
+    }
+    catch (const itk::ExceptionObject & e)
+    {
+      EXPECT_NE(std::string(e.GetDescription()).find("ReferenceEdgeLength must be finite and non-negative"),
+                std::string::npos)
+        << e.GetDescription();
+    }
+  }
+  // Root mean square edge about 1.1 mm: L = 20 mm gives w of about 330 and
+  // 2 b w^2 of about 22 000 sub-steps.
+  filter->SetReferenceEdgeLength(20.0);
+  filter->SetMaximumNumberOfSubSteps(500);
+  try
+  {
+    filter->Update();
+    ADD_FAILURE() << "an iteration of more sub-steps than MaximumNumberOfSubSteps ran";
+  }
+  catch (const itk::ExceptionObject & e)
+  {
+    EXPECT_NE(std::string(e.GetDescription()).find("more than MaximumNumberOfSubSteps (500)"), std::string::npos)
+      << e.GetDescription();
+  }
+  // The same reference length with the weights it needs runs, in sub-steps.
+  filter->SetElasticity(0.0);
+  filter->SetRigidity(0.0001);
+  filter->Update();
+  EXPECT_GT(filter->GetNumberOfSubSteps(), 1u);
+  EXPECT_LE(filter->GetNumberOfSubSteps(), 500u);
+  EXPECT_GT(filter->GetEdgeWeight(), 100.0);
 }
