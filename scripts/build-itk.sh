@@ -12,6 +12,10 @@
 #                      this directory and Module_ExplicitDeformableModel=ON.
 #                      Without it, the tree has the modules the module needs
 #                      (for a build through ITKModuleExternal).
+# EDM_ITK_WRAP_PYTHON=ON (with MODULE_SOURCE_DIR): ITK's Python wrapping
+#   (ITK_WRAP_PYTHON, Debian's castxml and swig) of the module and of only the
+#   ITK modules it depends on, for 3-D images and meshes of the default pixel
+#   types without RGB, RGBA, complex and signed short (scripts/ci-itk-python.sh).
 #
 # Trees are cached between runs under $EDM_ITK_CACHE (default
 # /var/cache/edm-itk), in a directory named by the version, the kind of tree
@@ -39,6 +43,11 @@ fi
 # Debian's libraries for ITK's third parties, GoogleTest, ccache.
 packages="cmake make g++ ccache xz-utils libgdcm-dev libpng-dev libjpeg-dev libtiff-dev zlib1g-dev
   libexpat1-dev libeigen3-dev libgtest-dev"
+wrap_python=${EDM_ITK_WRAP_PYTHON:-OFF}
+if [ "$wrap_python" = ON ]; then
+  [ -n "$module_dir" ] || { echo "build-itk: EDM_ITK_WRAP_PYTHON=ON needs MODULE_SOURCE_DIR" >&2; exit 2; }
+  packages="$packages castxml swig4.0 python3-dev python3-numpy"
+fi
 missing=""
 for p in $packages; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
@@ -70,7 +79,17 @@ esac
 for m in $modules; do
   options="$options -DModule_$m=ON"
 done
-if [ -n "$module_dir" ]; then
+if [ "$wrap_python" = ON ]; then
+  # Only the module and what it depends on (ITK enables those by itself;
+  # ITKGroup_Core, on by default, would add ITKTestKernel, the spatial objects,
+  # the transforms and more): every enabled module is wrapped.
+  kind=python
+  options=$(echo "$options" | sed 's/-DITK_WRAP_PYTHON=OFF//; s/-DModule_[A-Za-z0-9]*=ON//g')
+  options="$options -DITKGroup_Core=OFF -DModule_ExplicitDeformableModel=ON -DITK_WRAP_PYTHON=ON
+    -DITK_USE_SYSTEM_CASTXML=ON -DITK_USE_SYSTEM_SWIG=ON -DPython3_EXECUTABLE=/usr/bin/python3
+    -DITK_WRAP_IMAGE_DIMS=3 -DITK_WRAP_signed_short=OFF -DITK_WRAP_rgb_unsigned_char=OFF
+    -DITK_WRAP_rgba_unsigned_char=OFF -DITK_WRAP_complex_float=OFF"
+elif [ -n "$module_dir" ]; then
   kind=intree
   options="$options -DModule_ExplicitDeformableModel=ON"
 else
@@ -94,6 +113,16 @@ if [ ! -f "$src/.edm-unpacked" ]; then
   tar -xJf "$tarball" -C "$cache/src"
   [ -d "$src" ] || { echo "build-itk: $tarball does not unpack to ITK-$version/" >&2; exit 2; }
   touch "$src/.edm-unpacked"
+fi
+if [ "$wrap_python" = ON ] && [ -f "$src/Wrapping/Generators/Python/module_ext.i.in" ] &&
+   ! grep -q SWIGPY_SLICEOBJECT "$src/Wrapping/Generators/Python/module_ext.i.in"; then
+  # SWIG 4.1 (Debian 12's, package swig4.0) names the slice type SWIGPY_SLICEOBJECT, which
+  # ITK before 5.4 does not define (ITK issue 3782, fixed in 5.4 by the same
+  # definition): the wrappers do not compile without it. Wrapping only.
+  sed -i 's/^# define SWIGPY_SLICE_ARG(obj) ((PyObject\*) (obj))$/&\n# define SWIGPY_SLICEOBJECT PyObject/' \
+    "$src/Wrapping/Generators/Python/module_ext.i.in"
+  grep -q SWIGPY_SLICEOBJECT "$src/Wrapping/Generators/Python/module_ext.i.in" || {
+    echo "build-itk: could not define SWIGPY_SLICEOBJECT in ITK's module_ext.i.in" >&2; exit 2; }
 fi
 if [ -n "$module_dir" ]; then
   # Inside ITK's tree: Modules/Remote/<name> is where ITK's own
