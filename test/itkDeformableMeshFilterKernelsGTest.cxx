@@ -756,3 +756,41 @@ TEST(DeformableMeshFilterKernels, ReferenceEdgeLengthBadInputAndSubStepLimit)
   EXPECT_LE(filter->GetNumberOfSubSteps(), 500u);
   EXPECT_GT(filter->GetEdgeWeight(), 100.0);
 }
+
+// With sub-steps the diagnostics and the convergence measure are those of
+// the whole iteration: each vertex's displacement from where the iteration
+// started, not that of its last sub-step.
+TEST(DeformableMeshFilterKernels, SubStepsReportTheWholeIterationsDisplacement)
+{
+  const auto    mesh = MakeIrregularMesh();
+  const auto    forces = MakeForceImage();
+  const TermSet terms = { "sub-steps", 0.6, 0.2, true, 0.15, 0.2, 0.4, 1.4 };
+  auto          run = [&](unsigned int steps) {
+    auto filter = FilterType::New();
+    filter->SetInput(mesh);
+    filter->SetForceImage(forces);
+    filter->SetScaleFactor(terms.scaleFactor);
+    filter->SetElasticity(terms.elasticity);
+    filter->SetRigidity(terms.rigidity);
+    filter->SetBalloon(terms.balloon);
+    filter->SetMaximumStepLength(terms.maximumStep);
+    filter->SetReferenceEdgeLength(terms.referenceEdgeLength);
+    filter->SetNumberOfIterations(steps);
+    filter->Update();
+    return filter;
+  };
+  const auto before = run(2);
+  const auto after = run(3);
+  ASSERT_GT(after->GetNumberOfSubSteps(), 1u);
+  const auto & displacements = after->GetDisplacementMagnitudes();
+  ASSERT_EQ(displacements.size(), mesh->GetNumberOfPoints());
+  double largest = 0.0;
+  for (MeshType::PointIdentifier i = 0; i < mesh->GetNumberOfPoints(); ++i)
+  {
+    const double moved = after->GetOutput()->GetPoint(i).EuclideanDistanceTo(before->GetOutput()->GetPoint(i));
+    EXPECT_NEAR(displacements[i], moved, 1e-6 + 1e-6 * moved) << i;
+    largest = std::max(largest, moved);
+  }
+  EXPECT_DOUBLE_EQ(after->GetLastMaximumDisplacement(), largest);
+  EXPECT_GT(largest, 0.1);
+}
