@@ -213,7 +213,12 @@ public:
    * surface settles on the iso-surface of the bound that separates the object
    * from its surroundings and stays there whatever the number of iterations:
    * unlike the balloon, it needs no edge to stop it. A vertex outside the
-   * image deflates. Non-negative; 0 turns the region force off. Default: 0. */
+   * image deflates. The transition width is at least RegionWeight times the
+   * 99th percentile of the smoothed intensity's gradient magnitude (per mm),
+   * so that a vertex on a steep edge does not step past the bound: the
+   * region term converges for any weight, and near the boundary it behaves
+   * the same for weights above that (RegionForce::SetMinimumWidth()).
+   * Non-negative; 0 turns the region force off. Default: 0. */
   itkSetMacro(RegionWeight, double);
   itkGetConstMacro(RegionWeight, double);
 
@@ -224,34 +229,54 @@ public:
   itkSetMacro(RegionSigma, double);
   itkGetConstMacro(RegionSigma, double);
 
-  /** Half-width of the object's intensity range in robust standard
-   * deviations of the intensities sampled inside the initial surface, when
-   * the range is estimated (EstimateObjectIntensityRange on): the range is
-   * median +- IntensityTolerance x 1.4826 x MAD, or, for a piecewise constant
-   * object (that half-width below a fifth of the image's intensity range),
-   * halfway to the image's other extreme (RegionForce::Estimate()). Smaller
-   * values stop the surface at fainter edges. Positive. Default: 2.2 (on T1
-   * MRI of the brain, 2.0 and 2.5 move the Dice of a brain extraction by
-   * +0.01 and -0.03, and of the outline of a skull-stripped brain by -0.006
-   * and +0.003). */
+  /** Half-width of the object's intensity class in robust standard
+   * deviations of the object's intensities, when the object's model is
+   * estimated (EstimateObjectIntensityRange on) or given by
+   * SetObjectIntensityStatistics(): the class is median +- IntensityTolerance
+   * x 1.4826 x MAD, or, for a piecewise constant object (that half-width
+   * below a fifth of the image's intensity range), halfway to the image's
+   * other extreme (RegionForce::SetModel()). The class is the range until
+   * the surface reaches the background (EstimateBackgroundIntensity); it also
+   * separates the background's samples from the object's. Positive. Default:
+   * 2.2. */
   itkSetMacro(IntensityTolerance, double);
   itkGetConstMacro(IntensityTolerance, double);
 
-  /** When on (default), the object's intensity range is estimated at each
-   * reset from the interior of the input (initial) surface: intensities
-   * sampled between 10 % and 60 % of the way from each vertex toward the
-   * vertices' centroid, so a surface that is star-shaped around its centroid
-   * and lies inside the object samples the object only. When off, the range
+  /** When on (default), the object's model is estimated at each reset from
+   * the interior of the input (initial) surface: the median and robust
+   * spread of intensities sampled between 10 % and 60 % of the way from each
+   * vertex toward the vertices' centroid, so a surface that is star-shaped
+   * around its centroid and lies inside the object samples the object only.
+   * When off, the model given by SetObjectIntensityStatistics() or the range
    * given by SetObjectIntensityRange() is used. */
   itkSetMacro(EstimateObjectIntensityRange, bool);
   itkGetConstMacro(EstimateObjectIntensityRange, bool);
   itkBooleanMacro(EstimateObjectIntensityRange);
 
+  /** When on (default), with an estimated or given object model (not with a
+   * given range), the bounds of the range follow the background: every
+   * BackgroundUpdateInterval iterations, intensities are sampled 1 to 4
+   * voxels (of the intensity image's smallest spacing) outside each vertex
+   * along its normal; those below the object's class form the dark
+   * background, those above it the bright one, and a background holding at
+   * least 5 % of the samples moves its bound to halfway between the object's
+   * median and its own (RegionForce::AdaptToBackground()): the boundary of
+   * the two classes, where a blurred edge between them is steepest. Until
+   * the surface reaches a background, its bound stays at the class's. */
+  itkSetMacro(EstimateBackgroundIntensity, bool);
+  itkGetConstMacro(EstimateBackgroundIntensity, bool);
+  itkBooleanMacro(EstimateBackgroundIntensity);
+
+  /** Iterations between two estimates of the background (>= 1). Default: 10. */
+  itkSetMacro(BackgroundUpdateInterval, unsigned int);
+  itkGetConstMacro(BackgroundUpdateInterval, unsigned int);
+
   /** The object's intensity range [lower, upper] for the region force, in the
    * intensity image's units, and the transition width (intensity units, > 0)
-   * over which the speed goes from full deflation to full inflation. Turns
-   * EstimateObjectIntensityRange off. For a bright object on a dark
-   * background give an upper bound above the image's maximum. */
+   * over which the speed goes from full deflation to full inflation, fixed
+   * (no background estimate). Turns EstimateObjectIntensityRange off. For a
+   * bright object on a dark background give an upper bound above the image's
+   * maximum. */
   void
   SetObjectIntensityRange(double lower, double upper, double width)
   {
@@ -259,12 +284,32 @@ public:
     m_ObjectIntensityUpper = upper;
     m_ObjectIntensityWidth = width;
     m_EstimateObjectIntensityRange = false;
+    m_ObjectIntensityStatisticsGiven = false;
     this->Modified();
   }
-  /** The range in use: as set, or as estimated at the last reset. */
+  /** The object's model as the median and robust spread (standard deviation
+   * units, >= 0) of its intensities, in the intensity image's units, for
+   * instance those estimated by an earlier run (GetObjectIntensityMedian(),
+   * GetObjectIntensitySpread()): the range follows from them as when they are
+   * estimated (IntensityTolerance, EstimateBackgroundIntensity). Turns
+   * EstimateObjectIntensityRange off. */
+  void
+  SetObjectIntensityStatistics(double median, double spread)
+  {
+    m_ObjectIntensityMedian = median;
+    m_ObjectIntensitySpread = spread;
+    m_EstimateObjectIntensityRange = false;
+    m_ObjectIntensityStatisticsGiven = true;
+    this->Modified();
+  }
+  /** The range in use: as set, or as estimated (at the last reset, and from
+   * the background at the last iteration). */
   itkGetConstMacro(ObjectIntensityLower, double);
   itkGetConstMacro(ObjectIntensityUpper, double);
   itkGetConstMacro(ObjectIntensityWidth, double);
+  /** The object's model: as set, or as estimated at the last reset. */
+  itkGetConstMacro(ObjectIntensityMedian, double);
+  itkGetConstMacro(ObjectIntensitySpread, double);
 
   /** Reference edge length L, physical units (mm): the edge length at which
    * Elasticity and Rigidity have their nominal weight. When positive the
@@ -412,6 +457,14 @@ private:
   /** Fills m_NormalSpeeds (outward speed of each vertex, mm per iteration)
    * from the intensity image, at the current coordinates and the unit
    * normals m_Normals of the geometry pass. */
+  /** Stores the region force's range in the image's units (the getters). */
+  void
+  StoreObjectIntensityRange();
+
+  /** Moves the range's bounds from samples just outside the surface. */
+  void
+  EstimateBackground();
+
   void
   UpdateNormalSpeeds();
 
@@ -432,6 +485,11 @@ private:
   double       m_ObjectIntensityLower{ 0.0 };
   double       m_ObjectIntensityUpper{ 0.0 };
   double       m_ObjectIntensityWidth{ 1.0 };
+  double       m_ObjectIntensityMedian{ 0.0 };
+  double       m_ObjectIntensitySpread{ 0.0 };
+  bool         m_ObjectIntensityStatisticsGiven{ false };
+  bool         m_EstimateBackgroundIntensity{ true };
+  unsigned int m_BackgroundUpdateInterval{ 10 };
   double       m_ConvergenceTolerance{ 0.0 };
   unsigned int m_ConvergenceWindow{ 3 };
   /** Finite values and step bound of the force image (bad input). */
@@ -479,6 +537,8 @@ private:
   DeformableMeshFilterDetail::RegionForce      m_RegionForce;
   double                                       m_IntensityQuantiles[2]{}; // 2nd and 98th percentiles
   double                                       m_IntensityScale{ 1.0 };   // power of two applied before smoothing
+  double                                       m_BackgroundStep{ 1.0 };   // smallest spacing of the intensity image
+  double                                       m_IntensityGradientQuantile{ 0.0 }; // 99th percentile, per mm (scaled)
   using RegionForceType = DeformableMeshFilterDetail::RegionForce;
   std::vector<float> m_DisplacementMagnitudes;
   std::vector<float> m_ExternalForceMagnitudes;

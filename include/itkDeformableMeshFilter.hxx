@@ -691,6 +691,10 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "MaximumNumberOfSubSteps: " << m_MaximumNumberOfSubSteps << std::endl;
   os << indent << "NumberOfSubSteps: " << m_NumberOfSubSteps << std::endl;
   os << indent << "EdgeWeight: " << m_EdgeWeight << std::endl;
+  os << indent << "ObjectIntensityStatistics: median " << m_ObjectIntensityMedian << ", spread "
+     << m_ObjectIntensitySpread << (m_ObjectIntensityStatisticsGiven ? " (given)" : "") << std::endl;
+  os << indent << "EstimateBackgroundIntensity: " << m_EstimateBackgroundIntensity << std::endl;
+  os << indent << "BackgroundUpdateInterval: " << m_BackgroundUpdateInterval << std::endl;
   os << indent << "MaximumStepLength: " << m_MaximumStepLength << std::endl;
   os << indent << "ConvergenceTolerance: " << m_ConvergenceTolerance << std::endl;
   os << indent << "ConvergenceWindow: " << m_ConvergenceWindow << std::endl;

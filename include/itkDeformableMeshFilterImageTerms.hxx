@@ -44,7 +44,18 @@ DeformableMeshFilter<TMesh, TForceImage>::VerifyImageTermParameters() const
   {
     itkExceptionMacro("IntensityTolerance must be finite and positive; it is " << m_IntensityTolerance << ".");
   }
-  if (!m_EstimateObjectIntensityRange &&
+  if (m_BackgroundUpdateInterval < 1)
+  {
+    itkExceptionMacro("BackgroundUpdateInterval must be at least 1; it is " << m_BackgroundUpdateInterval << ".");
+  }
+  if (!m_EstimateObjectIntensityRange && m_ObjectIntensityStatisticsGiven &&
+      !(std::isfinite(m_ObjectIntensityMedian) && std::isfinite(m_ObjectIntensitySpread) &&
+        m_ObjectIntensitySpread >= 0.0))
+  {
+    itkExceptionMacro("The object intensity statistics must be finite with a non-negative spread; they are median "
+                      << m_ObjectIntensityMedian << ", spread " << m_ObjectIntensitySpread << ".");
+  }
+  if (!m_EstimateObjectIntensityRange && !m_ObjectIntensityStatisticsGiven &&
       !(std::isfinite(m_ObjectIntensityLower) && std::isfinite(m_ObjectIntensityUpper) &&
         m_ObjectIntensityLower <= m_ObjectIntensityUpper && m_ObjectIntensityWidth > 0.0 &&
         std::isfinite(m_ObjectIntensityWidth)))
@@ -130,8 +141,11 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareImageTerms()
     const std::vector<double> quantiles = RegionForceType::Quantiles(m_SmoothedIntensity, { 0.02, 0.98 });
     m_IntensityQuantiles[0] = quantiles[0];
     m_IntensityQuantiles[1] = quantiles[1];
+    m_IntensityGradientQuantile = RegionForceType::GradientQuantile(m_SmoothedIntensity, 0.99);
   }
   m_IntensitySampler.SetImage(m_SmoothedIntensity);
+  const auto & spacing = image->GetSpacing();
+  m_BackgroundStep = std::min(spacing[0], std::min(spacing[1], spacing[2]));
 }
 
 template <typename TMesh, typename TForceImage>
@@ -143,7 +157,9 @@ DeformableMeshFilter<TMesh, TForceImage>::EstimateImageTermModel()
   {
     const std::vector<double> samples =
       RegionForce::SampleInterior(m_IntensitySampler, this->GetCoordinates().data(), this->GetNumberOfCachedPoints());
-    if (!m_RegionForce.Estimate(samples, m_IntensityTolerance, m_IntensityQuantiles[0], m_IntensityQuantiles[1]))
+    double median = 0.0;
+    double spread = 0.0;
+    if (!RegionForce::Statistics(samples, median, spread))
     {
       itkExceptionMacro("Cannot estimate the object's intensity range: "
                         << (samples.empty() ? "the interior of the initial surface lies outside the intensity image"
@@ -151,9 +167,26 @@ DeformableMeshFilter<TMesh, TForceImage>::EstimateImageTermModel()
                         << "; give the range with SetObjectIntensityRange().");
     }
     // Reported in the image's units; the model works on the scaled ones.
-    m_ObjectIntensityLower = m_RegionForce.GetLower() / m_IntensityScale;
-    m_ObjectIntensityUpper = m_RegionForce.GetUpper() / m_IntensityScale;
-    m_ObjectIntensityWidth = m_RegionForce.GetWidth() / m_IntensityScale;
+    m_ObjectIntensityMedian = median / m_IntensityScale;
+    m_ObjectIntensitySpread = spread / m_IntensityScale;
+  }
+  // Stability of the region term: its speed changes by at most RegionWeight
+  // over the transition width; on an edge of the image's 99th percentile of
+  // gradient that is at most one step's worth of intensity.
+  m_RegionForce.SetMinimumWidth(m_RegionWeight * m_IntensityGradientQuantile);
+  if (m_EstimateObjectIntensityRange || m_ObjectIntensityStatisticsGiven)
+  {
+    if (!m_RegionForce.SetModel(m_ObjectIntensityMedian * m_IntensityScale,
+                                m_ObjectIntensitySpread * m_IntensityScale,
+                                m_IntensityTolerance,
+                                m_IntensityQuantiles[0],
+                                m_IntensityQuantiles[1]))
+    {
+      itkExceptionMacro("The object's intensity model (median " << m_ObjectIntensityMedian << ", spread "
+                                                                << m_ObjectIntensitySpread
+                                                                << ") gives no finite intensity range.");
+    }
+    this->StoreObjectIntensityRange();
   }
   else
   {
@@ -165,12 +198,59 @@ DeformableMeshFilter<TMesh, TForceImage>::EstimateImageTermModel()
 
 template <typename TMesh, typename TForceImage>
 void
+DeformableMeshFilter<TMesh, TForceImage>::StoreObjectIntensityRange()
+{
+  m_ObjectIntensityLower = m_RegionForce.GetLower() / m_IntensityScale;
+  m_ObjectIntensityUpper = m_RegionForce.GetUpper() / m_IntensityScale;
+  m_ObjectIntensityWidth = m_RegionForce.GetWidth() / m_IntensityScale;
+}
+
+template <typename TMesh, typename TForceImage>
+void
+DeformableMeshFilter<TMesh, TForceImage>::EstimateBackground()
+{
+  // Samples 1 to 4 voxels outside each vertex along its outward unit normal
+  // (stored by the geometry pass), in vertex order: the estimate does not
+  // depend on the number of threads.
+  const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
+  const double *      x = this->GetCoordinates().data();
+  const float *       normals = m_Normals.data();
+  std::vector<double> samples;
+  samples.reserve(4 * numberOfPoints);
+  for (SizeValueType i = 0; i < numberOfPoints; ++i)
+  {
+    for (unsigned int step = 1; step <= 4; ++step)
+    {
+      const double distance = step * m_BackgroundStep;
+      double       p[3];
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        p[k] = x[3 * i + k] + distance * static_cast<double>(normals[4 * i + k]);
+      }
+      const double value = m_IntensitySampler.Sample(p);
+      if (std::isfinite(value))
+      {
+        samples.push_back(value);
+      }
+    }
+  }
+  m_RegionForce.AdaptToBackground(samples);
+  this->StoreObjectIntensityRange();
+}
+
+template <typename TMesh, typename TForceImage>
+void
 DeformableMeshFilter<TMesh, TForceImage>::UpdateNormalSpeeds()
 {
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
   if (m_NormalSpeeds.size() != numberOfPoints)
   {
     m_NormalSpeeds.assign(numberOfPoints, 0.0f);
+  }
+  if (m_EstimateBackgroundIntensity && (m_EstimateObjectIntensityRange || m_ObjectIntensityStatisticsGiven) &&
+      this->GetCurrentIteration() % m_BackgroundUpdateInterval == 0 && m_Normals.size() == 4 * numberOfPoints)
+  {
+    this->EstimateBackground();
   }
   const double *          x = this->GetCoordinates().data();
   float *                 speeds = m_NormalSpeeds.data();

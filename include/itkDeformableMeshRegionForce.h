@@ -25,6 +25,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 namespace itk
@@ -201,39 +202,84 @@ public:
     return samples;
   }
 
-  /** Sets the range from the samples' median m and robust spread s
-   * (1.4826 times their median absolute deviation): [m - h, m + h] with
-   * h = k s, k the tolerance. When k s is below a fifth of the image's range
-   * (high - low, its 98th and 2nd percentiles), the object is piecewise
-   * constant (a binary or noiseless image) and h = max(m - low, high - m) / 2
-   * instead: the bound then lies halfway between the object's intensity and
-   * the image's other extreme, where the smoothed image crosses the object's
-   * edge. Width: max(s / 2, h / 8). Returns false when there is no sample. */
-  bool
-  Estimate(std::vector<double> samples, double tolerance, double low, double high)
+  /** The median and the robust spread (1.4826 times the median absolute
+   * deviation) of samples; false when there is none. */
+  static bool
+  Statistics(std::vector<double> samples, double & centre, double & spread)
   {
     if (samples.empty())
     {
       return false;
     }
-    const auto median = [](std::vector<double> & v) {
-      const auto middle = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-      std::nth_element(v.begin(), middle, v.end());
-      return *middle;
-    };
-    const double centre = median(samples);
+    centre = Median(samples);
     for (double & value : samples)
     {
       value = std::abs(value - centre);
     }
-    const double spread = 1.4826 * median(samples);
-    double       halfWidth = tolerance * spread;
+    spread = 1.4826 * Median(samples);
+    return std::isfinite(centre) && std::isfinite(spread);
+  }
+
+  /** Sets the object's model from its median m and robust spread s: the
+   * object's class is [m - h, m + h] with h = k s, k the tolerance. When k s
+   * is below a fifth of the image's range (high - low, its 98th and 2nd
+   * percentiles), the object is piecewise constant (a binary or noiseless
+   * image) and h = max(m - low, high - m) / 2 instead: the bound then lies
+   * halfway between the object's intensity and the image's other extreme,
+   * where the smoothed image crosses the object's edge. The range starts as
+   * the class; AdaptToBackground() moves it. Width: max(s / 2, h / 8).
+   * Returns false when the model is not finite. */
+  bool
+  SetModel(double centre, double spread, double tolerance, double low, double high)
+  {
+    double halfWidth = tolerance * spread;
     if (!(halfWidth >= 0.2 * (high - low)))
     {
       halfWidth = std::max(0.5 * (centre - low), 0.5 * (high - centre));
     }
-    SetRange(centre - halfWidth, centre + halfWidth, std::max(0.5 * spread, 0.125 * halfWidth));
+    m_Centre = centre;
+    m_ClassLower = centre - halfWidth;
+    m_ClassUpper = centre + halfWidth;
+    SetRange(m_ClassLower, m_ClassUpper, std::max(0.5 * spread, 0.125 * halfWidth));
     return std::isfinite(m_Lower) && std::isfinite(m_Upper) && m_Width > 0.0;
+  }
+
+  /** Statistics() and SetModel() of samples of the object. */
+  bool
+  Estimate(std::vector<double> samples, double tolerance, double low, double high)
+  {
+    double centre = 0.0;
+    double spread = 0.0;
+    return Statistics(std::move(samples), centre, spread) && SetModel(centre, spread, tolerance, low, high);
+  }
+
+  /** Moves the range's bounds from intensities sampled just outside the
+   * surface. The samples below the object's class form the dark background,
+   * those above it the bright background; a background with at least 5 % of
+   * the samples (and 16) puts its bound halfway between the object's median
+   * and its own median, the boundary of the two classes, where a blurred edge
+   * between them has its steepest slope. A background with fewer samples
+   * (the surface has not reached it) leaves its bound at the class's. */
+  void
+  AdaptToBackground(const std::vector<double> & samples)
+  {
+    std::vector<double> dark;
+    std::vector<double> bright;
+    for (const double value : samples)
+    {
+      if (value < m_ClassLower)
+      {
+        dark.push_back(value);
+      }
+      else if (value > m_ClassUpper)
+      {
+        bright.push_back(value);
+      }
+    }
+    const size_t minimum = std::max<size_t>(16, samples.size() / 20);
+    const double lower = dark.size() >= minimum ? 0.5 * (m_Centre + Median(dark)) : m_ClassLower;
+    const double upper = bright.size() >= minimum ? 0.5 * (m_Centre + Median(bright)) : m_ClassUpper;
+    SetRange(lower, upper, m_Width);
   }
 
   /** The q-quantiles (q in [0, 1]) of about a million voxels of image,
@@ -268,13 +314,67 @@ public:
     return result;
   }
 
+  /** The q-quantile of the gradient magnitude of image (intensity per mm:
+   * central differences, the image's spacing honoured) over about a million
+   * of its inner voxels, taken at a regular stride. */
+  static double
+  GradientQuantile(const Image<float, 3> * image, double q)
+  {
+    const auto &       size = image->GetBufferedRegion().GetSize();
+    const auto &       spacing = image->GetSpacing();
+    const float *      buffer = image->GetBufferPointer();
+    const size_t       sx = 1;
+    const size_t       sy = size[0];
+    const size_t       sz = size[0] * size[1];
+    const size_t       count = image->GetBufferedRegion().GetNumberOfPixels();
+    const size_t       stride = std::max<size_t>(1, count / 1000000) | 1;
+    std::vector<float> values;
+    values.reserve(count / stride + 1);
+    for (size_t offset = 0; offset < count; offset += stride)
+    {
+      const size_t i = offset % size[0];
+      const size_t j = (offset / size[0]) % size[1];
+      const size_t k = offset / sz;
+      if (i == 0 || j == 0 || k == 0 || i + 1 >= size[0] || j + 1 >= size[1] || k + 1 >= size[2])
+      {
+        continue;
+      }
+      const double gx = (buffer[offset + sx] - buffer[offset - sx]) / (2.0 * spacing[0]);
+      const double gy = (buffer[offset + sy] - buffer[offset - sy]) / (2.0 * spacing[1]);
+      const double gz = (buffer[offset + sz] - buffer[offset - sz]) / (2.0 * spacing[2]);
+      const double magnitude = std::sqrt(gx * gx + gy * gy + gz * gz);
+      if (std::isfinite(magnitude))
+      {
+        values.push_back(static_cast<float>(magnitude));
+      }
+    }
+    if (values.empty())
+    {
+      return 0.0;
+    }
+    const auto at = values.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(values.size() - 1));
+    std::nth_element(values.begin(), at, values.end());
+    return *at;
+  }
+
+  /** The smallest transition width: speed changes by at most weight (mm per
+   * iteration) over minimumWidth / gradient of intensity, so that a vertex
+   * on an edge of that gradient does not step beyond the bound (the
+   * linearised region term's gain per iteration is at most 1). */
+  void
+  SetMinimumWidth(double minimumWidth)
+  {
+    m_MinimumWidth = minimumWidth;
+    SetRange(m_Lower, m_Upper, m_Width);
+  }
+
   void
   SetRange(double lower, double upper, double width)
   {
     m_Lower = lower;
     m_Upper = upper;
-    m_Width = width;
-    m_InverseWidth = width > 0.0 ? 1.0 / width : 0.0;
+    m_Width = std::max(width, m_MinimumWidth);
+    m_InverseWidth = m_Width > 0.0 ? 1.0 / m_Width : 0.0;
   }
 
   double
@@ -307,6 +407,18 @@ public:
   }
 
 private:
+  static double
+  Median(std::vector<double> & values)
+  {
+    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), middle, values.end());
+    return *middle;
+  }
+
+  double m_MinimumWidth{ 0.0 };
+  double m_Centre{ 0.0 };
+  double m_ClassLower{ 0.0 };
+  double m_ClassUpper{ 0.0 };
   double m_Lower{ 0.0 };
   double m_Upper{ 0.0 };
   double m_Width{ 1.0 };

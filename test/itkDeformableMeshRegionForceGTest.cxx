@@ -26,6 +26,7 @@
 #include "gtest/gtest.h"
 
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 namespace
@@ -140,6 +141,61 @@ TEST(DeformableMeshRegionForce, EstimateFromRobustStatistics)
   EXPECT_FALSE(model.Estimate({}, 2.5, 0.0, 1.0));
 }
 
+TEST(DeformableMeshRegionForce, BackgroundMovesTheBoundsHalfwayToIt)
+{
+  itk::DeformableMeshFilterDetail::RegionForce model;
+  // Median 100, spread 10, tolerance 2: the object's class is [80, 120]
+  // (its half-width, 20, above a fifth of the image's range [60, 140]).
+  ASSERT_TRUE(model.SetModel(100.0, 10.0, 2.0, 60.0, 140.0));
+  EXPECT_DOUBLE_EQ(model.GetLower(), 80.0);
+  EXPECT_DOUBLE_EQ(model.GetUpper(), 120.0);
+  std::vector<double> samples(400, 100.0);
+  samples.resize(460, 20.0);  // 60 dark samples (13 %), median 20
+  samples.resize(470, 150.0); // 10 bright ones (2 %): too few to count
+  model.AdaptToBackground(samples);
+  EXPECT_DOUBLE_EQ(model.GetLower(), 60.0);
+  EXPECT_DOUBLE_EQ(model.GetUpper(), 120.0);
+  samples.resize(520, 180.0); // 60 bright ones, median 180
+  model.AdaptToBackground(samples);
+  EXPECT_DOUBLE_EQ(model.GetLower(), 60.0);
+  EXPECT_DOUBLE_EQ(model.GetUpper(), 140.0);
+  // The surface inside the object again: the bounds return to the class's.
+  model.AdaptToBackground(std::vector<double>(100, 101.0));
+  EXPECT_DOUBLE_EQ(model.GetLower(), 80.0);
+  EXPECT_DOUBLE_EQ(model.GetUpper(), 120.0);
+}
+
+TEST(DeformableMeshRegionForce, BackgroundPutsTheBoundOnTheEdge)
+{
+  // A ball of 100 on 20, with the object's model given as median 100 and
+  // spread 20 (tolerance 1): the class's lower bound is 80, which the
+  // smoothed edge (sigma 1 mm) crosses 0.67 mm inside the ball (the normal
+  // quantile of (80 - 20) / 80). The background (20) moves the bound to 60,
+  // halfway, where the smoothed edge is on the ball's boundary.
+  const ImageType::Pointer image = MakeBall(100.0f, 20.0f);
+  double                   means[2];
+  for (int background = 0; background < 2; ++background)
+  {
+    const FilterType::Pointer filter = MakeFilter(image, 800);
+    filter->SetIntensityTolerance(1.0);
+    filter->SetObjectIntensityStatistics(100.0, 20.0);
+    filter->SetEstimateBackgroundIntensity(background != 0);
+    filter->Update();
+    EXPECT_FALSE(filter->GetEstimateObjectIntensityRange());
+    EXPECT_DOUBLE_EQ(filter->GetObjectIntensityMedian(), 100.0);
+    // (The samples a voxel outside the ball still see its smoothed edge: 61.)
+    EXPECT_NEAR(filter->GetObjectIntensityLower(), background != 0 ? 60.0 : 80.0, 1.5);
+    double maximum;
+    RadialError(filter->GetOutput(), means[background], maximum);
+    if (background != 0)
+    {
+      EXPECT_LT(maximum, 0.5);
+    }
+  }
+  EXPECT_GT(means[0], 0.5) << "without the background the surface stops inside the edge";
+  EXPECT_LT(means[1], 0.25);
+}
+
 TEST(DeformableMeshRegionForce, BrightBallStopsOnItsBoundaryByItself)
 {
   const ImageType::Pointer image = MakeBall(100.0f, 20.0f);
@@ -150,8 +206,9 @@ TEST(DeformableMeshRegionForce, BrightBallStopsOnItsBoundaryByItself)
     const FilterType::Pointer filter = MakeFilter(image, iterations);
     filter->Update();
     // Estimated inside the initial sphere: the object's value, the bound
-    // halfway to the background (60).
-    EXPECT_NEAR(filter->GetObjectIntensityLower(), 60.0, 1.0);
+    // halfway to the background (60; 61 from the background's samples a
+    // voxel outside the ball, which still see its smoothed edge).
+    EXPECT_NEAR(filter->GetObjectIntensityLower(), 60.0, 1.5);
     double maximum;
     RadialError(filter->GetOutput(), means[k], maximum);
     EXPECT_LT(means[k], 0.25) << iterations << " iterations";
@@ -200,4 +257,10 @@ TEST(DeformableMeshRegionForce, GivenRangeAndBadParameters)
   const FilterType::Pointer badRange = MakeFilter(image, 10);
   badRange->SetObjectIntensityRange(5.0, 1.0, 1.0);
   EXPECT_THROW(badRange->Update(), itk::ExceptionObject);
+  const FilterType::Pointer badStatistics = MakeFilter(image, 10);
+  badStatistics->SetObjectIntensityStatistics(100.0, -1.0);
+  EXPECT_THROW(badStatistics->Update(), itk::ExceptionObject);
+  const FilterType::Pointer badInterval = MakeFilter(image, 10);
+  badInterval->SetBackgroundUpdateInterval(0);
+  EXPECT_THROW(badInterval->Update(), itk::ExceptionObject);
 }

@@ -29,6 +29,7 @@
 #include "itkBinaryThresholdImageFilter.h"
 #include "itkImage.h"
 #include "itkImageFileReader.h"
+#include "itkImageFileWriter.h"
 #include "itkImageRegionConstIteratorWithIndex.h"
 #include "itkLinearInterpolateImageFunction.h"
 #include "itkMesh.h"
@@ -92,7 +93,11 @@ Info(const std::string & referencePath)
 }
 
 int
-Score(const std::string & meshPath, const std::string & referencePath, double minDice, double maxMean)
+Score(const std::string & meshPath,
+      const std::string & referencePath,
+      double              minDice,
+      double              maxMean,
+      const std::string & maskPath)
 {
   const MaskType::Pointer reference = ReadMask(referencePath);
   auto                    meshReader = itk::MeshFileReader<MeshType>::New();
@@ -107,6 +112,13 @@ Score(const std::string & meshPath, const std::string & referencePath, double mi
   voxelise->SetOutsideValue(0);
   voxelise->Update();
   const MaskType * segmentation = voxelise->GetOutput();
+  if (!maskPath.empty())
+  {
+    auto writer = itk::ImageFileWriter<MaskType>::New();
+    writer->SetInput(segmentation);
+    writer->SetFileName(maskPath);
+    writer->Update();
+  }
 
   double                                           both = 0.0;
   double                                           inReference = 0.0;
@@ -195,8 +207,9 @@ main(int argc, char * argv[])
     }
     if (command == "score" && argc >= 4)
     {
-      double minDice = 0.0;
-      double maxMean = 1e300;
+      double      minDice = 0.0;
+      double      maxMean = 1e300;
+      std::string maskPath;
       for (int i = 4; i + 1 < argc; i += 2)
       {
         const std::string name = argv[i];
@@ -208,13 +221,17 @@ main(int argc, char * argv[])
         {
           maxMean = std::stod(argv[i + 1]);
         }
+        else if (name == "--write-mask")
+        {
+          maskPath = argv[i + 1];
+        }
         else
         {
           std::cerr << "edmScore: unknown option " << name << std::endl;
           return 2;
         }
       }
-      return Score(argv[2], argv[3], minDice, maxMean);
+      return Score(argv[2], argv[3], minDice, maxMean, maskPath);
     }
   }
   catch (const std::exception & error)
@@ -222,7 +239,8 @@ main(int argc, char * argv[])
     std::cerr << "edmScore: " << error.what() << std::endl;
     return 2;
   }
-  std::cerr << "usage: edmScore info REFERENCE | edmScore score MESH REFERENCE [--min-dice D] [--max-mean MM]"
+  std::cerr << "usage: edmScore info REFERENCE | edmScore score MESH REFERENCE [--min-dice D] [--max-mean MM] "
+               "[--write-mask MASK]"
             << std::endl;
   return 2;
 }

@@ -360,8 +360,9 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
   t.push_back({ model,
                 "--intensity-tolerance",
                 "K",
-                "half-width of the object's intensity range, estimated inside the initial surface, in robust "
-                "standard deviations (> 0)",
+                "half-width of the object's intensity class, estimated inside the initial surface, in robust "
+                "standard deviations (> 0); the range's bounds then move halfway to the background's intensity "
+                "once the surface reaches it (sampled 1 to 4 voxels outside)",
                 FormatNumber(GetCoreDefaults().IntensityTolerance),
                 [&o](const std::string & s) {
                   o.intensityTolerance = ParseDouble("--intensity-tolerance", s);
@@ -373,7 +374,8 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
   t.push_back({ model,
                 "--object-range",
                 "LO,HI",
-                "the object's intensity range for the region force, in image units, instead of the estimate",
+                "the object's intensity range for the region force, in image units, instead of the estimate "
+                "(fixed: no background estimate)",
                 "estimated inside the initial surface",
                 [&o](const std::string & s) {
                   const auto v = ParseList("--object-range", s, 2, "LO,HI");
@@ -397,7 +399,7 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
   t.push_back({ model,
                 "--iterations",
                 "N",
-                "largest number of iterations (0 writes the initial mesh)",
+                "largest number of iterations of each resolution level (0 writes the initial mesh)",
                 std::to_string(defaults::Iterations),
                 [&o](const std::string & s) { o.iterations = ParseUnsigned("--iterations", s); } });
   t.push_back({ model,

@@ -78,9 +78,6 @@ constexpr double RegionSigmaInVoxels = 1.0;
  * smallest spacing, and the largest number of points it creates. */
 constexpr double       EdgeLengthInVoxels = 1.0;
 constexpr unsigned int MaximumRefinedPoints = 2000000;
-/** Iteration cap of each refinement level (after the first, which has
- * --iterations): the refined surface starts on the boundary. */
-constexpr unsigned int RefinementIterations = 500;
 /** The first level's region force sees the image smoothed this many times
  * more than the later ones. */
 constexpr double CoarseRegionSigmaFactor = 2.0;
@@ -155,7 +152,6 @@ struct SegmentOptions
   double       objectRange[2]{ 0.0, 0.0 };
   double       maximumStepLength{ GetCoreDefaults().MaximumStepLength };
   unsigned int iterations{ defaults::Iterations };
-  unsigned int refinementIterations{ defaults::RefinementIterations };
   double       convergenceTolerance{ defaults::ConvergenceTolerance };
   unsigned int convergenceWindow{ GetCoreDefaults().ConvergenceWindow };
   unsigned int snapshotEvery{ defaults::SnapshotEvery };

@@ -144,17 +144,18 @@ SmallestSpacing(const ImageType * image)
 }
 
 /** True when p falls within the image's voxels (half a voxel beyond the first
- * and last voxel centres, the domain where the force is sampled). */
+ * and last voxel centres, the domain where the force is sampled), widened by
+ * margin voxels on each side. */
 bool
-IsInsideImage(const ImageType * image, const MeshType::PointType & p)
+IsInsideImage(const ImageType * image, const MeshType::PointType & p, double margin = 0.0)
 {
   itk::ContinuousIndex<double, 3> index;
   static_cast<void>(image->TransformPhysicalPointToContinuousIndex(p, index)); // the region test follows
   const auto & region = image->GetLargestPossibleRegion();
   for (unsigned int k = 0; k < 3; ++k)
   {
-    const double low = static_cast<double>(region.GetIndex()[k]) - 0.5;
-    if (!(index[k] >= low && index[k] <= low + static_cast<double>(region.GetSize()[k])))
+    const double low = static_cast<double>(region.GetIndex()[k]) - 0.5 - margin;
+    if (!(index[k] >= low && index[k] <= low + static_cast<double>(region.GetSize()[k]) + 2.0 * margin))
     {
       return false;
     }
@@ -377,20 +378,24 @@ EnclosedVolume(const MeshType * mesh)
 }
 
 /** A surface that left the image or collapsed is a failed run (exit 1),
- * not a result: nothing is written. */
+ * not a result: nothing is written. An object cut by the image's edge (the
+ * brainstem at the bottom of a head scan) holds the surface at that edge,
+ * where a vertex outside the image deflates: points within one voxel beyond
+ * the edge are that, not a surface that left. */
 void
 CheckFinalSurface(const ImageType * image, const MeshType * initial, const MeshType * final)
 {
   size_t outside = 0;
   for (auto it = final->GetPoints()->Begin(); it != final->GetPoints()->End(); ++it)
   {
-    outside += IsInsideImage(image, it.Value()) ? 0 : 1;
+    outside += IsInsideImage(image, it.Value(), 1.0) ? 0 : 1;
   }
   if (outside > 0)
   {
     throw Error("the surface left the image: " + std::to_string(outside) + " of " +
                   std::to_string(final->GetNumberOfPoints()) +
-                  " points lie outside it (a balloon or region force too strong for the image's edges?); nothing "
+                  " points lie more than a voxel outside it (a balloon or region force too strong for the image's "
+                  "edges?); nothing "
                   "written",
                 ExitFailure);
   }
@@ -470,9 +475,12 @@ Deform(const ImageType *        image,
     o.regionSigma >= 0.0 ? o.regionSigma : defaults::RegionSigmaInVoxels * SmallestSpacing(image);
   const double edgeLength = o.edgeLength > 0.0 ? o.edgeLength : defaults::EdgeLengthInVoxels * SmallestSpacing(image);
   MeshType::ConstPointer stageInput = initial;
-  bool                   haveRange = o.hasObjectRange;
-  double                 range[3] = { o.objectRange[0], o.objectRange[1], 0.1 * (o.objectRange[1] - o.objectRange[0]) };
-  itk::SizeValueType     iterationsBefore = 0;
+  // The object's intensity model (median and spread) is estimated once, from
+  // the initial surface; the background's bounds are estimated by every level
+  // from just outside its surface.
+  bool               haveModel = false;
+  double             model[2] = { 0.0, 0.0 };
+  itk::SizeValueType iterationsBefore = 0;
   if (snapshot)
   {
     snapshot(initial, 0);
@@ -496,14 +504,18 @@ Deform(const ImageType *        image,
     deform->SetRegionWeight(regionWeight);
     deform->SetRegionSigma(stage == 0 && !last ? defaults::CoarseRegionSigmaFactor * regionSigma : regionSigma);
     deform->SetIntensityTolerance(o.intensityTolerance);
-    if (haveRange)
+    if (o.hasObjectRange)
     {
-      deform->SetObjectIntensityRange(range[0], range[1], range[2]);
+      deform->SetObjectIntensityRange(o.objectRange[0], o.objectRange[1], 0.1 * (o.objectRange[1] - o.objectRange[0]));
+    }
+    else if (haveModel)
+    {
+      deform->SetObjectIntensityStatistics(model[0], model[1]);
     }
     deform->SetMaximumStepLength(o.maximumStepLength);
     deform->SetConvergenceTolerance(o.convergenceTolerance);
     deform->SetConvergenceWindow(o.convergenceWindow);
-    deform->SetNumberOfIterations(stage == 0 ? o.iterations : std::min(o.iterations, o.refinementIterations));
+    deform->SetNumberOfIterations(o.iterations);
     const std::string level = std::to_string(stageInput->GetNumberOfPoints()) + " points";
     progress.Start("deforming");
     const auto deformStart = std::chrono::steady_clock::now();
@@ -531,14 +543,19 @@ Deform(const ImageType *        image,
     {
       throw Error("deformation: " + OneLine(exception.GetDescription()));
     }
-    if (deform->GetRegionWeight() > 0.0 && !haveRange)
+    if (deform->GetRegionWeight() > 0.0 && !o.hasObjectRange && !haveModel)
     {
-      haveRange = true;
-      range[0] = deform->GetObjectIntensityLower();
-      range[1] = deform->GetObjectIntensityUpper();
-      range[2] = deform->GetObjectIntensityWidth();
-      progress.Note("region force: object intensity range [" + Format(range[0], 4) + ", " + Format(range[1], 4) +
-                    "], transition width " + Format(range[2], 3) + " (estimated inside the initial surface)");
+      haveModel = true;
+      model[0] = deform->GetObjectIntensityMedian();
+      model[1] = deform->GetObjectIntensitySpread();
+      progress.Note("region force: object intensity median " + Format(model[0], 4) + ", spread " + Format(model[1], 3) +
+                    " (estimated inside the initial surface)");
+    }
+    if (deform->GetRegionWeight() > 0.0)
+    {
+      progress.Note("region force: intensity range [" + Format(deform->GetObjectIntensityLower(), 4) + ", " +
+                    Format(deform->GetObjectIntensityUpper(), 4) + "], transition width " +
+                    Format(deform->GetObjectIntensityWidth(), 3));
     }
     if (snapshot && deform->GetCurrentIteration() % o.snapshotEvery != 0)
     {
