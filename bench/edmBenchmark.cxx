@@ -485,6 +485,108 @@ BM_EDM_OneStepPerUpdate(benchmark::State & state)
 }
 
 // ---------------------------------------------------------------------------
+// Issue 15: adaptive remeshing every 10 iterations (RemeshingEdgeLength the
+// sphere's mean edge length, so that the remesher works on a mesh that the
+// deformation keeps pulling out of the band), 2 threads, 20 steps per update
+// (the output's triangle cells are rebuilt once per update after a
+// remeshing).
+double
+MeanEdgeLength(const MeshType * mesh)
+{
+  double      sum = 0.0;
+  std::size_t count = 0;
+  for (auto it = mesh->GetCells()->Begin(); it != mesh->GetCells()->End(); ++it)
+  {
+    const auto * ids = it.Value()->PointIdsBegin();
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      sum += mesh->GetPoint(ids[k]).EuclideanDistanceTo(mesh->GetPoint(ids[(k + 1) % 3]));
+      ++count;
+    }
+  }
+  return count > 0 ? sum / static_cast<double>(count) : 0.0;
+}
+
+void
+BM_EDM_Remeshing(benchmark::State & state)
+{
+  const int64_t      requested = state.range(0);
+  constexpr unsigned threads = 2;
+  ThreadScope        scope(threads);
+  const MeshType *   input = ModelMesh(requested);
+  constexpr unsigned steps = 20;
+
+  auto model = ModelType::New();
+  model->SetInput(input);
+  model->SetForceImage(MeshForceImage());
+  model->SetScaleFactor(0.5);
+  model->SetElasticity(0.3);
+  model->SetRigidity(0.1);
+  model->SetRemeshingEdgeLength(MeanEdgeLength(input));
+  model->SetRemeshingInterval(10);
+  model->SetIterateFromZero(false);
+  model->SetNumberOfWorkUnits(4 * threads);
+  model->SetNumberOfIterations(1);
+  model->Update();
+
+  int64_t vertexIterations = 0;
+  for (auto _ : state)
+  {
+    const auto vertices = static_cast<int64_t>(model->GetOutput()->GetNumberOfPoints());
+    model->SetNumberOfIterations(model->GetCurrentIteration() + steps);
+    model->Update();
+    vertexIterations += steps * (vertices + static_cast<int64_t>(model->GetOutput()->GetNumberOfPoints())) / 2;
+  }
+  state.counters["vertices"] = static_cast<double>(model->GetOutput()->GetNumberOfPoints());
+  state.counters["remeshings"] = static_cast<double>(model->GetNumberOfRemeshings());
+  state.counters["vertex_it/s"] =
+    benchmark::Counter(static_cast<double>(vertexIterations), benchmark::Counter::kIsRate);
+  state.SetLabel("remeshing every 10 iterations, steps/update=20");
+}
+
+// Issue 15 item 5: the plain step on itk::RegularSphereMeshSource's sphere of
+// 262 146 points (resolution 8), whose subdivisions number new points far
+// from their neighbours; Elasticity 0.1, Rigidity 0.05, 2 threads; with the
+// filter's renumbering for locality (range(0) = 1) and without.
+void
+BM_EDM_RegularSphereSource(benchmark::State & state)
+{
+  static MeshType::Pointer sphere = [] {
+    MeshType::PointType centre;
+    centre.Fill(MeshCentre);
+    return itk::MakeSphereMesh<MeshType>(centre, InitialRadius, 8);
+  }();
+  constexpr unsigned threads = 2;
+  ThreadScope        scope(threads);
+  constexpr unsigned steps = 20;
+  const auto         vertices = static_cast<int64_t>(sphere->GetNumberOfPoints());
+
+  auto model = ModelType::New();
+  model->SetInput(sphere);
+  model->SetForceImage(MeshForceImage());
+  model->SetScaleFactor(0.5);
+  model->SetElasticity(0.1);
+  model->SetRigidity(0.05);
+  model->SetRenumberForLocality(state.range(0) != 0);
+  model->SetIterateFromZero(false);
+  model->SetNumberOfWorkUnits(4 * threads);
+  model->SetNumberOfIterations(1);
+  model->Update();
+
+  int64_t stepsRun = 0;
+  for (auto _ : state)
+  {
+    model->SetNumberOfIterations(model->GetCurrentIteration() + steps);
+    model->Update();
+    stepsRun += steps;
+  }
+  state.counters["vertices"] = static_cast<double>(vertices);
+  state.counters["vertex_it/s"] =
+    benchmark::Counter(static_cast<double>(vertices * stepsRun), benchmark::Counter::kIsRate);
+  state.SetLabel(state.range(0) != 0 ? "renumbered for locality" : "input numbering");
+}
+
+// ---------------------------------------------------------------------------
 // ITK's DeformableSimplexMesh3DFilter. The steps are timed without the
 // per-update set-up (Initialize(): neighbour sets for every vertex), the
 // same loop as its GenerateData().
@@ -849,6 +951,20 @@ BENCHMARK(BM_EDM_OneStepPerUpdate)
   ->UseRealTime()
   ->Unit(benchmark::kMillisecond)
   ->ComputeStatistics("max", Largest);
+BENCHMARK(BM_EDM_Remeshing)
+  ->Arg(100000)
+  ->Arg(1000000)
+  ->ArgName("vertices")
+  ->UseRealTime()
+  ->Unit(benchmark::kMillisecond)
+  ->ComputeStatistics("max", Largest);
+BENCHMARK(BM_EDM_RegularSphereSource)
+  ->Arg(1)
+  ->Arg(0)
+  ->ArgName("renumber")
+  ->UseRealTime()
+  ->Unit(benchmark::kMillisecond)
+  ->ComputeStatistics("max", Largest);
 BENCHMARK(BM_ITK_DeformableSimplexMesh3D)->Apply([](benchmark::internal::Benchmark * b) { MeshArguments(b, false); });
 #ifdef EDM_BENCHMARK_WITH_VTK
 BENCHMARK(BM_VTK_ProbeWarp)->Apply([](benchmark::internal::Benchmark * b) { MeshArguments(b, true); });
@@ -975,6 +1091,26 @@ PrintSummary()
                   portable * 1e-6);
       PrintRatio("AVX2+FMA / SSE2", avx2, sse2);
       PrintRatio("SSE2 / portable", sse2, portable);
+    }
+  }
+  {
+    const double remesh100k = Rate("BM_EDM_Remeshing/vertices:100000/real_time");
+    const double remesh1M = Rate("BM_EDM_Remeshing/vertices:1000000/real_time");
+    const double renumbered = Rate("BM_EDM_RegularSphereSource/renumber:1/real_time");
+    const double asInput = Rate("BM_EDM_RegularSphereSource/renumber:0/real_time");
+    if (remesh100k + remesh1M > 0.0)
+    {
+      std::printf("remeshing every 10 iterations, 2 threads: 100000 vertices %.2f M, 1000000 vertices %.2f M "
+                  "vertex-iterations/s (issue 15 target: 25 M)\n",
+                  remesh100k * 1e-6,
+                  remesh1M * 1e-6);
+    }
+    if (renumbered + asInput > 0.0)
+    {
+      std::printf("RegularSphereMeshSource, 262146 vertices, 2 threads: renumbered %.2f M, input numbering %.2f M "
+                  "vertex-iterations/s (issue 15 target: 50 M)\n",
+                  renumbered * 1e-6,
+                  asInput * 1e-6);
     }
   }
   for (const char * size : { "128", "256" })

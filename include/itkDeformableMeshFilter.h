@@ -22,6 +22,7 @@
 #include "itkImage.h"
 #include "itkDeformableMeshFilterDetail.h"
 #include "itkDeformableMeshRegionForce.h"
+#include "itkDeformableMeshRemesher.h"
 #include "itkForceImageCheck.h"
 
 #include <cstdint>
@@ -114,6 +115,29 @@ namespace itk
  * length, external and internal force lengths, physical units) are available
  * with GetDisplacementMagnitudes(), GetExternalForceMagnitudes() and
  * GetInternalForceMagnitudes().
+ *
+ * Adaptive remeshing (RemeshingEdgeLength > 0): after the step of every
+ * RemeshingInterval-th iteration, DeformableMeshRemesher brings the edge
+ * lengths into [4/5, 4/3] x RemeshingEdgeLength (splits, collapses, flips
+ * toward valence 6, tangential relaxation) on the step's flat arrays, and
+ * the step's tables are rebuilt. The output then has the remeshed points and
+ * one TriangleCell per triangle, no point or cell data (see
+ * IterativeMeshFilter); the iteration contract holds as before
+ * (CurrentIteration, continuation with IterateFromZero off, abort, restart,
+ * IterationEvent with the current mesh, diagnostics sized to the current
+ * mesh). Remeshing needs a mesh of triangles only (an input with other cells
+ * is refused with an ExceptionObject at the first update); boundary edges are
+ * split but kept, non-manifold parts left alone (DeformableMeshRemesher).
+ * The balloon's per-vertex release and the diagnostics of a new vertex are
+ * those of its parent vertex.
+ *
+ * Renumbering: at each reset, an input whose numbering is not local (more
+ * than a tenth of its edges join points numbered more than 2048 apart, as in
+ * itk::RegularSphereMeshSource's subdivisions) is renumbered internally
+ * along a Morton curve of its positions, so that the step's speed does not
+ * depend on the input's numbering; the output keeps the input's numbering
+ * and the diagnostics are indexed by the input's point identifiers. A
+ * remeshed mesh keeps a local numbering (DeformableMeshRemesher).
  *
  * \sa ExternalForceImageFilter, IterativeMeshFilter
  * \ingroup ExplicitDeformableModel
@@ -381,18 +405,40 @@ public:
   const std::vector<float> &
   GetDisplacementMagnitudes() const
   {
-    return m_DisplacementMagnitudes;
+    return this->GetOutputPointIdentifiers().empty() ? m_DisplacementMagnitudes : m_PublicDisplacementMagnitudes;
   }
   const std::vector<float> &
   GetExternalForceMagnitudes() const
   {
-    return m_ExternalForceMagnitudes;
+    return this->GetOutputPointIdentifiers().empty() ? m_ExternalForceMagnitudes : m_PublicExternalForceMagnitudes;
   }
   const std::vector<float> &
   GetInternalForceMagnitudes() const
   {
-    return m_InternalForceMagnitudes;
+    return this->GetOutputPointIdentifiers().empty() ? m_InternalForceMagnitudes : m_PublicInternalForceMagnitudes;
   }
+
+  /** Target edge length of the adaptive remeshing, physical units (mm):
+   * every RemeshingInterval iterations the edges are brought into
+   * [4/5, 4/3] times this length. 0 turns remeshing off: the mesh keeps the
+   * input's points and cells. Must be finite and non-negative. Default: 0. */
+  itkSetMacro(RemeshingEdgeLength, double);
+  itkGetConstMacro(RemeshingEdgeLength, double);
+
+  /** Number of iterations between two remeshings (the mesh is remeshed after
+   * iterations K, 2K, ...). At least 1. Default: 10. */
+  itkSetMacro(RemeshingInterval, unsigned int);
+  itkGetConstMacro(RemeshingInterval, unsigned int);
+
+  /** Number of remeshings since the last reset. */
+  itkGetConstMacro(NumberOfRemeshings, SizeValueType);
+
+  /** When on (default), an input whose numbering is not local is renumbered
+   * internally at reset (see the class documentation). Off keeps the
+   * input's order (for measurements). */
+  itkSetMacro(RenumberForLocality, bool);
+  itkGetConstMacro(RenumberForLocality, bool);
+  itkBooleanMacro(RenumberForLocality);
 
   /** Sign applied to the triangles' orientation to get outward normals: +1 for
    * an outward-oriented mesh, -1 for an inward-oriented one. Set by Reset(). */
@@ -426,8 +472,32 @@ protected:
 private:
   using IndexType32 = uint32_t;
 
+  /** The triangles (polygons fan-triangulated, for the normals) and edges of
+   * the input's cells; \a onlyTriangles tells whether all cells are
+   * triangles. */
   void
-  BuildTopology();
+  GatherInputCells(std::vector<IndexType32> & triangles, std::vector<uint64_t> & edges, bool & onlyTriangles) const;
+
+  /** The step's tables from triangles and edges (min << 32 | max, any order,
+   * duplicates allowed unless \a edgesUnique; consumed). */
+  void
+  BuildTopology(const std::vector<IndexType32> & triangles, std::vector<uint64_t> & edges, bool edgesUnique = false);
+
+  /** Renumbers the cached points for locality when their numbering is not
+   * local; relabels \a triangles and \a edges. */
+  void
+  RenumberForLocality(std::vector<IndexType32> & triangles, std::vector<uint64_t> & edges);
+
+  /** Remeshes the cached surface and rebuilds the step's state. */
+  void
+  Remesh();
+
+  /** Diagnostics in the output's numbering, when the points are renumbered. */
+  void
+  PublishDiagnostics();
+
+  static constexpr SizeValueType RenumberingWindow = 2048;
+  static constexpr double        RenumberingFarEdgeFraction = 0.1;
 
   void
   PrepareForceSampler();
@@ -468,30 +538,39 @@ private:
   void
   UpdateNormalSpeeds();
 
-  double       m_ScaleFactor{ 1.0 };
-  double       m_Elasticity{ 0.0 };
-  bool         m_TangentialElasticity{ true };
-  double       m_Rigidity{ 0.0 };
-  double       m_Balloon{ 0.0 };
-  double       m_MaximumStepLength{ 0.0 };
-  double       m_ReferenceEdgeLength{ 0.0 };
-  unsigned int m_MaximumNumberOfSubSteps{ 1000 };
-  unsigned int m_NumberOfSubSteps{ 1 };
-  double       m_EdgeWeight{ 1.0 };
-  double       m_RegionWeight{ 0.0 };
-  double       m_RegionSigma{ 1.0 };
-  double       m_IntensityTolerance{ 2.2 };
-  bool         m_EstimateObjectIntensityRange{ true };
-  double       m_ObjectIntensityLower{ 0.0 };
-  double       m_ObjectIntensityUpper{ 0.0 };
-  double       m_ObjectIntensityWidth{ 1.0 };
-  double       m_ObjectIntensityMedian{ 0.0 };
-  double       m_ObjectIntensitySpread{ 0.0 };
-  bool         m_ObjectIntensityStatisticsGiven{ false };
-  bool         m_EstimateBackgroundIntensity{ true };
-  unsigned int m_BackgroundUpdateInterval{ 10 };
-  double       m_ConvergenceTolerance{ 0.0 };
-  unsigned int m_ConvergenceWindow{ 3 };
+  double        m_ScaleFactor{ 1.0 };
+  double        m_Elasticity{ 0.0 };
+  bool          m_TangentialElasticity{ true };
+  double        m_Rigidity{ 0.0 };
+  double        m_Balloon{ 0.0 };
+  double        m_MaximumStepLength{ 0.0 };
+  double        m_ReferenceEdgeLength{ 0.0 };
+  unsigned int  m_MaximumNumberOfSubSteps{ 1000 };
+  unsigned int  m_NumberOfSubSteps{ 1 };
+  double        m_EdgeWeight{ 1.0 };
+  double        m_RegionWeight{ 0.0 };
+  double        m_RegionSigma{ 1.0 };
+  double        m_IntensityTolerance{ 2.2 };
+  bool          m_EstimateObjectIntensityRange{ true };
+  double        m_ObjectIntensityLower{ 0.0 };
+  double        m_ObjectIntensityUpper{ 0.0 };
+  double        m_ObjectIntensityWidth{ 1.0 };
+  double        m_ObjectIntensityMedian{ 0.0 };
+  double        m_ObjectIntensitySpread{ 0.0 };
+  bool          m_ObjectIntensityStatisticsGiven{ false };
+  bool          m_EstimateBackgroundIntensity{ true };
+  unsigned int  m_BackgroundUpdateInterval{ 10 };
+  double        m_ConvergenceTolerance{ 0.0 };
+  unsigned int  m_ConvergenceWindow{ 3 };
+  double        m_RemeshingEdgeLength{ 0.0 };
+  unsigned int  m_RemeshingInterval{ 10 };
+  bool          m_RenumberForLocality{ true };
+  bool          m_Renumbered{ false };
+  double        m_FarEdgeFraction{ 0.0 };
+  SizeValueType m_NumberOfRemeshings{ 0 };
+  // The surface's triangles in the internal numbering (remeshing only).
+  std::vector<IndexType32> m_Triangles;
+  DeformableMeshRemesher   m_Remesher;
   /** Finite values and step bound of the force image (bad input). */
   ForceImageCheck<ForceImageType> m_ForceImageCheck;
 
@@ -543,6 +622,10 @@ private:
   std::vector<float> m_DisplacementMagnitudes;
   std::vector<float> m_ExternalForceMagnitudes;
   std::vector<float> m_InternalForceMagnitudes;
+  // The same in the output's numbering, when the points are renumbered.
+  std::vector<float> m_PublicDisplacementMagnitudes;
+  std::vector<float> m_PublicExternalForceMagnitudes;
+  std::vector<float> m_PublicInternalForceMagnitudes;
 
   // Force sampler, prepared at each update: continuous index
   // c = M (x - origin) - bufferStart, with M's columns as vectors.

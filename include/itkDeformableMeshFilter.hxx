@@ -23,6 +23,8 @@
 #include "itkDeformableMeshUpdateRule.h"
 #include "itkMultiThreaderBase.h"
 
+#include <type_traits>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -76,6 +78,15 @@ DeformableMeshFilter<TMesh, TForceImage>::VerifyPreconditions() const
   if (!(m_ConvergenceTolerance >= 0.0 && std::isfinite(m_ConvergenceTolerance)))
   {
     itkExceptionMacro("ConvergenceTolerance must be finite and non-negative; it is " << m_ConvergenceTolerance << ".");
+  }
+  if (!(m_RemeshingEdgeLength >= 0.0 && std::isfinite(m_RemeshingEdgeLength)))
+  {
+    itkExceptionMacro("RemeshingEdgeLength must be finite and positive (or 0 to turn remeshing off); it is "
+                      << m_RemeshingEdgeLength << ".");
+  }
+  if (m_RemeshingInterval == 0)
+  {
+    itkExceptionMacro("RemeshingInterval must be at least 1 iteration; it is 0.");
   }
   this->VerifyImageTermParameters();
 }
@@ -147,20 +158,18 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareForceSampler()
 
 template <typename TMesh, typename TForceImage>
 void
-DeformableMeshFilter<TMesh, TForceImage>::BuildTopology()
+DeformableMeshFilter<TMesh, TForceImage>::GatherInputCells(std::vector<IndexType32> & triangles,
+                                                           std::vector<uint64_t> &    edges,
+                                                           bool &                     onlyTriangles) const
 {
-  using namespace DeformableMeshFilterDetail;
   const MeshType *    input = this->GetInput();
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
   if (numberOfPoints >= std::numeric_limits<IndexType32>::max())
   {
     itkExceptionMacro("The input mesh has too many points (" << numberOfPoints << ").");
   }
-
-  std::vector<uint64_t> edges;
-  // Triangles (polygons fan-triangulated), needed only to build the tables.
-  std::vector<IndexType32> triangles;
-  auto                     addEdge = [&](uint64_t a, uint64_t b) {
+  onlyTriangles = true;
+  auto addEdge = [&](uint64_t a, uint64_t b) {
     if (a != b)
     {
       edges.push_back(std::min(a, b) << 32 | std::max(a, b));
@@ -187,6 +196,7 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology()
                                     << numberOfPoints << " points.");
         }
       }
+      onlyTriangles = onlyTriangles && type == CommonEnums::CellGeometry::TRIANGLE_CELL && n == 3;
       if (isSurface && n >= 3)
       {
         for (unsigned int k = 0; k < n; ++k)
@@ -210,9 +220,21 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology()
       }
     }
   }
+}
 
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+template <typename TMesh, typename TForceImage>
+void
+DeformableMeshFilter<TMesh, TForceImage>::BuildTopology(const std::vector<IndexType32> & triangles,
+                                                        std::vector<uint64_t> &          edges,
+                                                        bool                             edgesUnique)
+{
+  using namespace DeformableMeshFilterDetail;
+  const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
+  if (!edgesUnique)
+  {
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  }
 
   // CSR vertex-neighbour table.
   m_NeighbourOffsets.assign(numberOfPoints + 1, 0);
@@ -420,7 +442,28 @@ template <typename TMesh, typename TForceImage>
 void
 DeformableMeshFilter<TMesh, TForceImage>::Reset()
 {
-  this->BuildTopology();
+  std::vector<IndexType32> triangles;
+  std::vector<uint64_t>    edges;
+  bool                     onlyTriangles = true;
+  this->GatherInputCells(triangles, edges, onlyTriangles);
+  if (m_RemeshingEdgeLength > 0.0 && !onlyTriangles)
+  {
+    itkExceptionMacro("RemeshingEdgeLength is " << m_RemeshingEdgeLength
+                                                << ", but the input mesh has cells other than triangles (lines, "
+                                                   "polygons, vertices): remeshing works on triangle meshes only. "
+                                                   "Triangulate the mesh or set RemeshingEdgeLength to 0.");
+  }
+  this->RenumberForLocality(triangles, edges);
+  this->BuildTopology(triangles, edges);
+  if (m_RemeshingEdgeLength > 0.0)
+  {
+    m_Triangles.swap(triangles);
+  }
+  else
+  {
+    std::vector<IndexType32>().swap(m_Triangles);
+  }
+  m_NumberOfRemeshings = 0;
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
   // The kernels load 4 doubles from a point's 3 coordinates: both arrays
   // of coordinates, swapped at each step, end with a guard value.
@@ -669,6 +712,139 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   {
     m_QuietIterations = 0;
   }
+
+  // Remeshing after the step of every RemeshingInterval-th iteration: the
+  // output of such an iteration is the remeshed surface.
+  if (m_RemeshingEdgeLength > 0.0 && (this->GetCurrentIteration() + 1) % m_RemeshingInterval == 0)
+  {
+    this->Remesh();
+  }
+  if (diagnose)
+  {
+    this->PublishDiagnostics();
+  }
+}
+
+template <typename TMesh, typename TForceImage>
+void
+DeformableMeshFilter<TMesh, TForceImage>::PublishDiagnostics()
+{
+  // Indexed by output point identifier: the internal order scattered back
+  // when the filter renumbered the input's points.
+  const std::vector<uint32_t> & ids = this->GetOutputPointIdentifiers();
+  if (ids.empty() || ids.size() != m_DisplacementMagnitudes.size())
+  {
+    std::vector<float>().swap(m_PublicDisplacementMagnitudes);
+    std::vector<float>().swap(m_PublicExternalForceMagnitudes);
+    std::vector<float>().swap(m_PublicInternalForceMagnitudes);
+    return;
+  }
+  const std::size_t n = ids.size();
+  m_PublicDisplacementMagnitudes.resize(n);
+  m_PublicExternalForceMagnitudes.resize(n);
+  m_PublicInternalForceMagnitudes.resize(n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    m_PublicDisplacementMagnitudes[ids[i]] = m_DisplacementMagnitudes[i];
+    m_PublicExternalForceMagnitudes[ids[i]] = m_ExternalForceMagnitudes[i];
+    m_PublicInternalForceMagnitudes[ids[i]] = m_InternalForceMagnitudes[i];
+  }
+}
+
+template <typename TMesh, typename TForceImage>
+void
+DeformableMeshFilter<TMesh, TForceImage>::RenumberForLocality(std::vector<IndexType32> & triangles,
+                                                              std::vector<uint64_t> &    edges)
+{
+  // The step reads the coordinates of each vertex's neighbours: when many
+  // edges join vertices numbered far apart (more than 2048 apart, 48 kB of
+  // coordinates), those reads miss the caches. Such a numbering is replaced
+  // by the Morton order of the positions; a local one is kept as it is (the
+  // output bit for bit as without renumbering).
+  const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
+  std::size_t         far = 0;
+  for (const uint64_t e : edges)
+  {
+    far += (e & 0xffffffffULL) - (e >> 32) > RenumberingWindow;
+  }
+  const bool renumber = m_RenumberForLocality && numberOfPoints > RenumberingWindow && !edges.empty() &&
+                        static_cast<double>(far) > RenumberingFarEdgeFraction * static_cast<double>(edges.size());
+  m_FarEdgeFraction = edges.empty() ? 0.0 : static_cast<double>(far) / static_cast<double>(edges.size());
+  m_Renumbered = renumber;
+  if (!renumber)
+  {
+    return;
+  }
+  std::vector<double> &          x = this->GetCoordinates();
+  const std::vector<IndexType32> order = DeformableMeshRemesher::LocalityOrder(x.data(), numberOfPoints);
+  std::vector<IndexType32>       rank(numberOfPoints);
+  std::vector<double>            permuted(3 * numberOfPoints);
+  for (SizeValueType k = 0; k < numberOfPoints; ++k)
+  {
+    rank[order[k]] = static_cast<IndexType32>(k);
+    std::copy(x.data() + 3 * static_cast<SizeValueType>(order[k]),
+              x.data() + 3 * static_cast<SizeValueType>(order[k]) + 3,
+              permuted.data() + 3 * k);
+  }
+  std::copy(permuted.begin(), permuted.end(), x.begin());
+  for (IndexType32 & v : triangles)
+  {
+    v = rank[v];
+  }
+  for (uint64_t & e : edges)
+  {
+    const uint64_t a = rank[e >> 32];
+    const uint64_t b = rank[e & 0xffffffffULL];
+    e = std::min(a, b) << 32 | std::max(a, b);
+  }
+  this->SetOutputPointIdentifiers(std::vector<uint32_t>(order.begin(), order.end()));
+}
+
+template <typename TMesh, typename TForceImage>
+void
+DeformableMeshFilter<TMesh, TForceImage>::Remesh()
+{
+  std::vector<double> & x = this->GetCoordinates();
+  const SizeValueType   numberOfPoints = this->GetNumberOfCachedPoints();
+  x.resize(3 * numberOfPoints); // the guard value goes
+  m_Remesher.SetTargetEdgeLength(m_RemeshingEdgeLength);
+  m_Remesher.Remesh(x, numberOfPoints, m_Triangles);
+  const std::vector<IndexType32> & parents = m_Remesher.Parents();
+  const SizeValueType              newNumberOfPoints = parents.size();
+  if (newNumberOfPoints >= std::numeric_limits<IndexType32>::max())
+  {
+    itkExceptionMacro("Remeshing made too many points (" << newNumberOfPoints << ").");
+  }
+  x.push_back(0.0);
+  m_NextCoordinates.assign(3 * newNumberOfPoints + 1, 0.0);
+
+  // Per-vertex state carried from each new vertex's parent (itself, or an
+  // end-point of the edge it was split from).
+  const auto remap = [&parents, newNumberOfPoints](auto & values) {
+    if (values.empty())
+    {
+      return;
+    }
+    std::remove_reference_t<decltype(values)> mapped(newNumberOfPoints);
+    for (SizeValueType i = 0; i < newNumberOfPoints; ++i)
+    {
+      mapped[i] = values[parents[i]];
+    }
+    values.swap(mapped);
+  };
+  remap(m_BalloonReleased);
+  remap(m_DisplacementMagnitudes);
+  remap(m_ExternalForceMagnitudes);
+  remap(m_InternalForceMagnitudes);
+  std::vector<float>().swap(m_Umbrella);
+  std::vector<float>().swap(m_Normals);
+  std::vector<float>().swap(m_NormalSpeeds);
+
+  this->SetCachedTriangles(newNumberOfPoints, m_Triangles);
+  std::vector<uint64_t> edges;
+  const bool            unique = m_Remesher.Edges(edges);
+  this->BuildTopology(m_Triangles, edges, unique);
+  ++m_NumberOfRemeshings;
 }
 
 template <typename TMesh, typename TForceImage>
@@ -705,6 +881,12 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "Neighbours: " << m_Neighbours.size() << " entries, Triangles: " << m_NumberOfTriangles
      << ", vertices outside a single fan: " << m_GeneralVertices.size() << std::endl;
   os << indent << "OrderedByValence: " << (m_ValenceOrder.empty() ? "Off" : "On") << std::endl;
+  os << indent << "RemeshingEdgeLength: " << m_RemeshingEdgeLength << std::endl;
+  os << indent << "RemeshingInterval: " << m_RemeshingInterval << std::endl;
+  os << indent << "NumberOfRemeshings: " << m_NumberOfRemeshings << std::endl;
+  os << indent << "RenumberForLocality: " << (m_RenumberForLocality ? "On" : "Off") << std::endl;
+  os << indent << "Renumbered: " << (m_Renumbered ? "true" : "false") << " (far edge fraction " << m_FarEdgeFraction
+     << ")" << std::endl;
   os << indent << "ForceBuffer: " << m_ForceBuffer << std::endl;
   os << indent << "PhysicalToIndex: [" << m_PhysicalToIndex[0][0] << ' ' << m_PhysicalToIndex[0][1] << ' '
      << m_PhysicalToIndex[0][2] << "; " << m_PhysicalToIndex[1][0] << ' ' << m_PhysicalToIndex[1][1] << ' '

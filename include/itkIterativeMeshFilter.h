@@ -21,6 +21,8 @@
 #include "itkMeshToMeshFilter.h"
 #include "itkExplicitDeformableModelCompatibility.h"
 
+#include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace itk
@@ -52,6 +54,16 @@ namespace itk
  * Cells, cell data and point data of the input are copied to the output; only
  * point coordinates change. Point identifiers must be 0 to N-1 (the layout of
  * the default VectorContainer-based meshes).
+ *
+ * A subclass may change the mesh while it iterates (remeshing,
+ * SetCachedTriangles()): from then on, until the next restart, the output has
+ * the subclass's points (numbered 0 to N'-1) and one TriangleCell per
+ * triangle (identifiers 0 to T-1, in the subclass's order); the input's point
+ * data and cell data no longer apply and the output has none (empty
+ * containers). The cells are rebuilt only when an output is seen: at the end
+ * of an update and before an IterationEvent. A subclass may also hold its
+ * points in an order of its own (SetOutputPointIdentifiers()); the output
+ * keeps the input's numbering then.
  *
  * Subclasses implement Iterate() on the coordinate cache (GetCoordinates(): a
  * flat array of N * PointDimension doubles in physical units, point after
@@ -99,6 +111,15 @@ public:
   itkSetMacro(IterateFromZero, bool);
   itkGetConstMacro(IterateFromZero, bool);
   itkBooleanMacro(IterateFromZero);
+
+  /** True when the subclass changed the mesh (remeshing) since the last
+   * restart: the output then has the subclass's points and triangle cells,
+   * not the input's structure. */
+  bool
+  GetTopologyChanged() const
+  {
+    return m_TopologyChanged;
+  }
 
 protected:
   IterativeMeshFilter();
@@ -162,6 +183,29 @@ protected:
   void
   UpdateOutputPoints();
 
+  /** For a subclass that holds its points in an order of its own: the
+   * output identifier of each cached point (a permutation of 0 to N-1), or
+   * empty (the default, reset at each restart) for the cached order itself. */
+  void
+  SetOutputPointIdentifiers(std::vector<uint32_t> identifiers)
+  {
+    m_OutputPointIdentifiers = std::move(identifiers);
+  }
+  const std::vector<uint32_t> &
+  GetOutputPointIdentifiers() const
+  {
+    return m_OutputPointIdentifiers;
+  }
+
+  /** For a subclass that changed the mesh (remeshing): the cache now holds
+   * \a numberOfPoints points (GetCoordinates() resized by the subclass) and
+   * the surface is \a triangles (3 point indices per triangle, in the cached
+   * order). The output gets these triangles as its cells, no point or cell
+   * data, and the cached numbering (SetOutputPointIdentifiers() is reset). */
+  void
+  SetCachedTriangles(SizeValueType numberOfPoints, const std::vector<uint32_t> & triangles);
+
+
 private:
   using OutputCellsContainer = typename OutputMeshType::CellsContainer;
 
@@ -182,6 +226,11 @@ private:
   void
   ReleaseOutputCells();
 
+  /** Gives the output the structure of the changed mesh: triangle cells
+   * (rebuilt when stale), empty point and cell data. */
+  void
+  InstallChangedStructure();
+
   SizeValueType       m_NumberOfIterations{ 0 };
   SizeValueType       m_CurrentIteration{ 0 };
   bool                m_IterateFromZero{ true };
@@ -189,7 +238,15 @@ private:
   ModifiedTimeType    m_CachedInputTime{ 0 };
   std::vector<double> m_Coordinates;
   SizeValueType       m_NumberOfCachedPoints{ 0 };
+  SizeValueType       m_NumberOfInputPoints{ 0 }; // of the input when it was cached
   bool                m_OutputPointsFinite{ true };
+
+  // A mesh changed by the subclass: its triangles, and whether the output
+  // cells describe them yet; the output identifiers of the cached points.
+  bool                  m_TopologyChanged{ false };
+  bool                  m_OutputCellsStale{ false };
+  std::vector<uint32_t> m_CachedTriangles;
+  std::vector<uint32_t> m_OutputPointIdentifiers;
 
   // The output's structure and points, reused from one update to the next:
   // cloning the cells at every update costs more than a step on large meshes.

@@ -19,6 +19,7 @@
 #define itkIterativeMeshFilter_hxx
 
 #include "itkIterativeMeshFilter.h"
+#include "itkTriangleCell.h"
 
 #include <algorithm>
 #include <cmath>
@@ -95,6 +96,7 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::CacheInput()
     }
   }
   m_NumberOfCachedPoints = numberOfPoints;
+  m_NumberOfInputPoints = numberOfPoints;
   m_CachedInputTime = std::max(input->GetMTime(), input->GetUpdateMTime());
 }
 
@@ -128,8 +130,11 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::ThrowNonFiniteCoordinate(SizeValue
   {
     ++i;
   }
-  const double value = i < n ? m_Coordinates[i] : std::numeric_limits<double>::quiet_NaN();
-  itkExceptionMacro("Point #" << i / PointDimension << " has a non-finite coordinate (" << value << ") after iteration "
+  const double        value = i < n ? m_Coordinates[i] : std::numeric_limits<double>::quiet_NaN();
+  const SizeValueType point = i / PointDimension;
+  const SizeValueType pointId =
+    point < m_OutputPointIdentifiers.size() ? static_cast<SizeValueType>(m_OutputPointIdentifiers[point]) : point;
+  itkExceptionMacro("Point #" << pointId << " has a non-finite coordinate (" << value << ") after iteration "
                               << m_CurrentIteration << " (this update ran iterations " << firstIteration + 1 << " to "
                               << m_CurrentIteration
                               << "): the step diverged. Likely causes: a force image holding NaN or infinite "
@@ -153,11 +158,15 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::RunIterations()
   const ModifiedTimeType inputTime = std::max(input->GetMTime(), input->GetUpdateMTime());
   const bool             restart = !m_Cached || m_IterateFromZero || m_NumberOfIterations == 0 ||
                        m_NumberOfIterations < m_CurrentIteration || inputTime > m_CachedInputTime ||
-                       input->GetNumberOfPoints() != this->GetNumberOfCachedPoints();
+                       input->GetNumberOfPoints() != m_NumberOfInputPoints;
   if (restart)
   {
     m_Cached = false;
     this->ReleaseOutputCells();
+    m_TopologyChanged = false;
+    m_OutputCellsStale = false;
+    std::vector<uint32_t>().swap(m_CachedTriangles);
+    m_OutputPointIdentifiers.clear();
     this->CacheInput();
     m_CurrentIteration = 0;
     this->Reset();
@@ -166,19 +175,26 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::RunIterations()
 
   // Structure first, so that an observer of IterationEvent sees a whole mesh.
   // The cells are cloned once per restart; later updates share the clone.
-  if (m_OutputCells.IsNull())
+  if (m_TopologyChanged)
   {
-    this->CopyInputMeshToOutputMeshCells();
-    m_OutputCells = this->GetOutput()->GetCells();
+    this->InstallChangedStructure();
   }
   else
   {
-    this->GetOutput()->SetCellsAllocationMethod(
-      MeshEnums::MeshClassCellsAllocationMethod::CellsAllocatedDynamicallyCellByCell);
-    this->GetOutput()->SetCells(m_OutputCells);
+    if (m_OutputCells.IsNull())
+    {
+      this->CopyInputMeshToOutputMeshCells();
+      m_OutputCells = this->GetOutput()->GetCells();
+    }
+    else
+    {
+      this->GetOutput()->SetCellsAllocationMethod(
+        MeshEnums::MeshClassCellsAllocationMethod::CellsAllocatedDynamicallyCellByCell);
+      this->GetOutput()->SetCells(m_OutputCells);
+    }
+    this->CopyInputMeshToOutputMeshCellData();
+    this->CopyInputMeshToOutputMeshPointData();
   }
-  this->CopyInputMeshToOutputMeshCellData();
-  this->CopyInputMeshToOutputMeshPointData();
   this->UpdateOutputPoints();
 
   const SizeValueType firstIteration = m_CurrentIteration;
@@ -189,6 +205,10 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::RunIterations()
     ++m_CurrentIteration;
     if (this->HasObserver(IterationEvent()))
     {
+      if (m_OutputCellsStale)
+      {
+        this->InstallChangedStructure();
+      }
       // Observers never see a non-finite mesh.
       this->UpdateOutputPoints();
       if (!m_OutputPointsFinite)
@@ -202,6 +222,10 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::RunIterations()
     {
       break;
     }
+  }
+  if (m_OutputCellsStale)
+  {
+    this->InstallChangedStructure();
   }
   this->UpdateOutputPoints();
   if (!m_OutputPointsFinite)
@@ -231,12 +255,13 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::UpdateOutputPoints()
   // which costs as much as a step of DeformableMeshFilter on large meshes.
   // The finite check rides on the copy: x * 0 is 0 for a finite x and NaN for
   // an infinite or NaN one.
-  auto &         elements = points->CastToSTLContainer();
-  const double * x = m_Coordinates.data();
-  double         check = 0.0;
+  auto &           elements = points->CastToSTLContainer();
+  const double *   x = m_Coordinates.data();
+  double           check = 0.0;
+  const uint32_t * ids = m_OutputPointIdentifiers.size() == numberOfPoints ? m_OutputPointIdentifiers.data() : nullptr;
   for (SizeValueType i = 0; i < numberOfPoints; ++i, x += PointDimension)
   {
-    OutputPointType & p = elements[i];
+    OutputPointType & p = elements[ids ? ids[i] : i];
     for (unsigned int d = 0; d < PointDimension; ++d)
     {
       p[d] = static_cast<typename OutputPointType::ValueType>(x[d]);
@@ -246,6 +271,50 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::UpdateOutputPoints()
   m_OutputPointsFinite = check == 0.0;
   points->Modified();
   output->SetPoints(points);
+}
+
+template <typename TInputMesh, typename TOutputMesh>
+void
+IterativeMeshFilter<TInputMesh, TOutputMesh>::SetCachedTriangles(SizeValueType                 numberOfPoints,
+                                                                 const std::vector<uint32_t> & triangles)
+{
+  m_NumberOfCachedPoints = numberOfPoints;
+  m_CachedTriangles = triangles;
+  m_TopologyChanged = true;
+  m_OutputCellsStale = true;
+  m_OutputPointIdentifiers.clear();
+}
+
+template <typename TInputMesh, typename TOutputMesh>
+void
+IterativeMeshFilter<TInputMesh, TOutputMesh>::InstallChangedStructure()
+{
+  OutputMeshType * output = this->GetOutput();
+  if (m_OutputCellsStale || m_OutputCells.IsNull())
+  {
+    using CellType = typename OutputMeshType::CellType;
+    using TriangleType = TriangleCell<CellType>;
+    this->ReleaseOutputCells();
+    auto                cells = OutputCellsContainer::New();
+    const SizeValueType numberOfTriangles = m_CachedTriangles.size() / 3;
+    cells->Reserve(numberOfTriangles);
+    auto & elements = cells->CastToSTLContainer();
+    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+    {
+      auto * triangle = new TriangleType;
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        triangle->SetPointId(k, m_CachedTriangles[3 * t + k]);
+      }
+      elements[t] = triangle;
+    }
+    m_OutputCells = cells;
+    m_OutputCellsStale = false;
+  }
+  output->SetCellsAllocationMethod(MeshEnums::MeshClassCellsAllocationMethod::CellsAllocatedDynamicallyCellByCell);
+  output->SetCells(m_OutputCells);
+  output->SetCellData(OutputMeshType::CellDataContainer::New());
+  output->SetPointData(OutputMeshType::PointDataContainer::New());
 }
 
 template <typename TInputMesh, typename TOutputMesh>
@@ -262,6 +331,11 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::PrintSelf(std::ostream & os, Inden
   os << indent << "OutputPoints: " << (m_OutputPoints ? m_OutputPoints->Size() : 0) << " reusable points" << std::endl;
   os << indent << "Coordinates: " << this->GetNumberOfCachedPoints() << " cached points" << std::endl;
   os << indent << "OutputPointsFinite: " << (m_OutputPointsFinite ? "true" : "false") << std::endl;
+  os << indent << "NumberOfInputPoints: " << m_NumberOfInputPoints << std::endl;
+  os << indent << "TopologyChanged: " << (m_TopologyChanged ? "true" : "false") << ", " << m_CachedTriangles.size() / 3
+     << " triangles" << (m_OutputCellsStale ? " (output cells stale)" : "") << std::endl;
+  os << indent << "OutputPointIdentifiers: " << (m_OutputPointIdentifiers.empty() ? "cached order" : "renumbered")
+     << std::endl;
 }
 
 } // end namespace itk

@@ -364,7 +364,10 @@ TEST(IterativeMeshFilter, PrintsEveryMember)
                                "OutputCells: 4 shared cells",
                                "OutputPoints: 4 reusable points",
                                "Coordinates: 4 cached points",
-                               "OutputPointsFinite: true" })
+                               "OutputPointsFinite: true",
+                               "NumberOfInputPoints: 4",
+                               "TopologyChanged: false",
+                               "OutputPointIdentifiers: cached order" })
   {
     EXPECT_NE(os.str().find(member), std::string::npos) << member << " in\n" << os.str();
   }

@@ -1,0 +1,1271 @@
+/*=========================================================================
+ *
+ *  Copyright NumFOCUS
+ *
+ *  Licensed under the Apache License, Version 2.0 (the "License");
+ *  you may not use this file except in compliance with the License.
+ *  You may obtain a copy of the License at
+ *
+ *         http://www.apache.org/licenses/LICENSE-2.0.txt
+ *
+ *  Unless required by applicable law or agreed to in writing, software
+ *  distributed under the License is distributed on an "AS IS" BASIS,
+ *  WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+ *  See the License for the specific language governing permissions and
+ *  limitations under the License.
+ *
+ *=========================================================================*/
+#ifndef itkDeformableMeshRemesher_h
+#define itkDeformableMeshRemesher_h
+
+#include "itkMacro.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numeric>
+#include <vector>
+
+namespace itk
+{
+
+/** \class DeformableMeshRemesher
+ * \brief Isotropic remeshing of a triangle surface held in flat arrays: the
+ * remeshing step of DeformableMeshFilter, usable on its own.
+ *
+ * Remesh() brings the edge lengths of a triangle mesh into the band
+ * [MinimumRatio L, MaximumRatio L] around the target edge length L (physical
+ * units, mm), in the manner of the isotropic remeshing of Botsch and Kobbelt
+ * (2004), in one round of four passes:
+ * -# split: every edge longer than MaximumRatio L is split at its midpoint,
+ *    repeatedly until none is;
+ * -# collapse: an edge shorter than MinimumRatio L is collapsed to its
+ *    midpoint, unless that would make the mesh non-manifold (the two
+ *    end-points share neighbours other than the two opposite vertices, or an
+ *    opposite vertex has only three neighbours), turn a triangle around (its
+ *    normal reversed), or create an edge longer than MaximumRatio L;
+ * -# flip: an edge shared by two triangles is flipped when that brings the
+ *    numbers of neighbours of the four vertices closer to 6 (4 on a
+ *    boundary), unless the new edge exists already or a triangle would turn
+ *    around or fold (the two new triangles' normals more than 60 degrees
+ *    apart while the old ones were not);
+ * -# tangential relaxation: every free vertex moves halfway to the centroid
+ *    of its neighbours, within the tangent plane (the component along the
+ *    vertex normal removed), which evens the triangles' shapes without
+ *    moving the surface; a move that would turn a triangle around is not
+ *    made;
+ * and a last split pass, so that no edge is longer than MaximumRatio L when
+ * Remesh() returns. Edges shorter than MinimumRatio L may remain where every
+ * collapse was refused.
+ *
+ * What is left alone: boundary edges (one triangle) are split at their
+ * midpoint but never flipped or collapsed, and boundary vertices never move,
+ * so an open surface keeps its boundary curve exactly; edges shared by more
+ * than two triangles (or by two triangles of opposite orientations) and
+ * vertices whose triangles do not form one fan (non-manifold parts) are
+ * frozen: no operation touches them. Points that no triangle uses are
+ * dropped.
+ *
+ * The output vertices are numbered for locality: the vertices kept, in their
+ * input order, each followed by the vertices split from its edges, so a mesh
+ * numbered for locality stays so. Parents() gives, for each output vertex,
+ * the input vertex it comes from (the vertex itself, or the first end-point
+ * of the edge it was split from), for carrying per-vertex state.
+ *
+ * Deterministic: the same input gives the same output, bit for bit.
+ *
+ * \sa DeformableMeshFilter
+ * \ingroup ExplicitDeformableModel
+ */
+class DeformableMeshRemesher
+{
+public:
+  using IndexType = uint32_t;
+
+  /** Counts of the operations of the last Remesh(). */
+  struct Statistics
+  {
+    std::size_t splits{ 0 };
+    std::size_t collapses{ 0 };
+    std::size_t flips{ 0 };
+    std::size_t relaxed{ 0 };
+  };
+
+  /** Target edge length L, physical units (mm). Must be finite and
+   * positive. Default: 1. */
+  void
+  SetTargetEdgeLength(double length)
+  {
+    m_TargetEdgeLength = length;
+  }
+  double
+  GetTargetEdgeLength() const
+  {
+    return m_TargetEdgeLength;
+  }
+
+  /** The band of the edge lengths, as fractions of the target: edges below
+   * MinimumRatio L are collapsed, above MaximumRatio L split. Defaults: 4/5
+   * and 4/3 (Botsch and Kobbelt). Need 0 < MinimumRatio < MaximumRatio / 2
+   * is not required, but MinimumRatio < MaximumRatio is. */
+  void
+  SetEdgeLengthRatios(double minimumRatio, double maximumRatio)
+  {
+    m_MinimumRatio = minimumRatio;
+    m_MaximumRatio = maximumRatio;
+  }
+  double
+  GetMinimumEdgeLength() const
+  {
+    return m_MinimumRatio * m_TargetEdgeLength;
+  }
+  double
+  GetMaximumEdgeLength() const
+  {
+    return m_MaximumRatio * m_TargetEdgeLength;
+  }
+
+  /** Number of tangential relaxation sweeps per Remesh(). Default: 1. */
+  void
+  SetRelaxationSweeps(unsigned int sweeps)
+  {
+    m_RelaxationSweeps = sweeps;
+  }
+
+  /** Remeshes in place: \a coordinates holds 3 doubles per vertex (at least
+   * 3 * numberOfPoints; the rest is ignored and dropped), \a triangles 3
+   * vertex indices per triangle. On return both describe the new mesh.
+   * Throws an ExceptionObject for a bad target length or a triangle that
+   * refers to a missing point. */
+  Statistics
+  Remesh(std::vector<double> & coordinates, std::size_t numberOfPoints, std::vector<IndexType> & triangles);
+
+  /** The edges of the last Remesh()'s output, as (min << 32 | max) of their
+   * end-points, in no particular order; returns true when each edge is
+   * listed once (false when frozen non-manifold edges may repeat). */
+  bool
+  Edges(std::vector<uint64_t> & edges) const
+  {
+    edges = m_Edges;
+    return m_EdgesUnique;
+  }
+
+  /** For each vertex of the last Remesh()'s output, the input vertex it
+   * comes from. */
+  const std::vector<IndexType> &
+  Parents() const
+  {
+    return m_Parents;
+  }
+
+  /** A renumbering of \a numberOfPoints points for locality: order[k] is the
+   * point that takes number k. The points are sorted along a Morton
+   * (Z-order) curve of their positions on a 2^21 grid over their bounding
+   * box, so that neighbours on a surface mostly get close numbers. */
+  static std::vector<IndexType>
+  LocalityOrder(const double * coordinates, std::size_t numberOfPoints);
+
+  /** A locality measure of a numbering: the fraction of the edges of the
+   * triangles whose end-points are numbered more than \a window apart. */
+  static double
+  FarEdgeFraction(const std::vector<IndexType> & triangles, std::size_t window);
+
+private:
+  static constexpr IndexType Invalid = std::numeric_limits<IndexType>::max();
+  static constexpr int64_t   Boundary = -1;
+  static constexpr int64_t   NonManifold = -2;
+
+  static IndexType
+  Next(IndexType c)
+  {
+    return c % 3 == 2 ? c - 2 : c + 1;
+  }
+  static IndexType
+  Prev(IndexType c)
+  {
+    return c % 3 == 0 ? c + 2 : c - 1;
+  }
+
+  void
+  Build(std::size_t numberOfPoints);
+  /** The neighbours (in fan order) and corners of vertex v; false for a
+   * frozen vertex. */
+  bool
+  Ring(IndexType v, std::vector<IndexType> & neighbours, std::vector<IndexType> * corners) const;
+  IndexType
+  NewVertex(const double * p, IndexType parent);
+  double
+  Length2(IndexType a, IndexType b) const;
+  void
+  TriangleNormal(IndexType a, IndexType b, IndexType c, double n[3]) const;
+  void
+  TriangleNormal(const double * a, const double * b, const double * c, double n[3]) const;
+
+  bool
+  SplitPass();
+  void
+  Split(IndexType c);
+  void
+  CollapsePass();
+  bool
+  TryCollapse(IndexType c, bool fromTwin = false);
+  void
+  FlipPass();
+  /** Flips the edge of corner c when that improves the valences or, with
+   * \a lengthen, when the new edge is longer and at most the maximum. */
+  bool
+  TryFlip(IndexType c, bool lengthen = false);
+  void
+  Relax();
+  /** Moves the end-points of each edge still shorter than the minimum apart
+   * along it, when no other edge of theirs leaves the band and no triangle
+   * turns around. */
+  void
+  LengthenPass();
+  bool
+  MoveKeepsBand(IndexType v, const double * q, IndexType other) const;
+  void
+  Compact(std::vector<double> & coordinates, std::vector<IndexType> & triangles);
+
+  double       m_TargetEdgeLength{ 1.0 };
+  double       m_MinimumRatio{ 0.8 };
+  double       m_MaximumRatio{ 4.0 / 3.0 };
+  unsigned int m_RelaxationSweeps{ 1 };
+
+  // Corner table: corner c = 3 t + k is vertex m_V[c] of triangle t; the
+  // half-edge of corner c goes from m_V[c] to m_V[Next(c)]; m_O[c] is the
+  // corner of the opposite half-edge, Boundary or NonManifold.
+  std::vector<IndexType> m_V;
+  std::vector<int64_t>   m_O;
+  std::vector<IndexType> m_VertexCorner; // a corner of each vertex, Invalid if none
+  std::vector<int32_t>   m_Valence;
+  std::vector<uint8_t>   m_State; // 0 free, 1 boundary, 2 frozen, 3 removed
+  std::vector<double>    m_X;
+  std::vector<IndexType> m_Parents;
+  std::vector<uint64_t>  m_Edges;
+  bool                   m_EdgesUnique{ true };
+  std::size_t            m_InputPoints{ 0 };
+  Statistics             m_Statistics;
+  double                 m_Min2{ 0.0 };
+  double                 m_Max2{ 0.0 };
+  // Scratch.
+  std::vector<IndexType> m_RingA;
+  std::vector<IndexType> m_RingB;
+  std::vector<IndexType> m_CornersA;
+  std::vector<IndexType> m_CornersB;
+};
+
+enum : uint8_t
+{
+  RemesherFree = 0,
+  RemesherBoundary = 1,
+  RemesherFrozen = 2,
+  RemesherRemoved = 3
+};
+
+inline double
+DeformableMeshRemesher::Length2(IndexType a, IndexType b) const
+{
+  const double * p = m_X.data() + 3 * static_cast<std::size_t>(a);
+  const double * q = m_X.data() + 3 * static_cast<std::size_t>(b);
+  const double   d0 = p[0] - q[0];
+  const double   d1 = p[1] - q[1];
+  const double   d2 = p[2] - q[2];
+  return d0 * d0 + d1 * d1 + d2 * d2;
+}
+
+inline void
+DeformableMeshRemesher::TriangleNormal(const double * a, const double * b, const double * c, double n[3]) const
+{
+  const double u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+  const double v[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+  n[0] = u[1] * v[2] - u[2] * v[1];
+  n[1] = u[2] * v[0] - u[0] * v[2];
+  n[2] = u[0] * v[1] - u[1] * v[0];
+}
+
+inline void
+DeformableMeshRemesher::TriangleNormal(IndexType a, IndexType b, IndexType c, double n[3]) const
+{
+  this->TriangleNormal(m_X.data() + 3 * static_cast<std::size_t>(a),
+                       m_X.data() + 3 * static_cast<std::size_t>(b),
+                       m_X.data() + 3 * static_cast<std::size_t>(c),
+                       n);
+}
+
+inline DeformableMeshRemesher::IndexType
+DeformableMeshRemesher::NewVertex(const double * p, IndexType parent)
+{
+  const auto v = static_cast<IndexType>(m_State.size());
+  m_X.insert(m_X.end(), p, p + 3);
+  m_VertexCorner.push_back(Invalid);
+  m_Valence.push_back(0);
+  m_State.push_back(RemesherFree);
+  m_Parents.push_back(parent);
+  return v;
+}
+
+inline void
+DeformableMeshRemesher::Build(std::size_t numberOfPoints)
+{
+  const std::size_t numberOfCorners = m_V.size();
+  // Corners of each vertex (CSR), to find the opposite half-edges.
+  std::vector<IndexType> offsets(numberOfPoints + 1, 0);
+  for (const IndexType v : m_V)
+  {
+    ++offsets[v + 1];
+  }
+  for (std::size_t i = 0; i < numberOfPoints; ++i)
+  {
+    offsets[i + 1] += offsets[i];
+  }
+  std::vector<IndexType> corners(numberOfCorners);
+  {
+    std::vector<IndexType> fill(offsets.begin(), offsets.end() - 1);
+    for (std::size_t c = 0; c < numberOfCorners; ++c)
+    {
+      corners[fill[m_V[c]]++] = static_cast<IndexType>(c);
+    }
+  }
+  m_O.assign(numberOfCorners, Boundary);
+  for (std::size_t c = 0; c < numberOfCorners; ++c)
+  {
+    const IndexType a = m_V[c];
+    const IndexType b = m_V[Next(static_cast<IndexType>(c))];
+    unsigned        same = 0;
+    unsigned        opposite = 0;
+    IndexType       twin = Invalid;
+    if (a == b)
+    {
+      m_O[c] = NonManifold;
+      continue;
+    }
+    for (IndexType k = offsets[a]; k < offsets[a + 1]; ++k)
+    {
+      const IndexType d = corners[k];
+      same += m_V[Next(d)] == b;
+      opposite += m_V[Prev(d)] == b; // half-edge b -> a ends at a
+      if (m_V[Prev(d)] == b)
+      {
+        twin = Prev(d);
+      }
+    }
+    if (same == 1 && opposite == 1)
+    {
+      m_O[c] = twin;
+    }
+    else if (same == 1 && opposite == 0)
+    {
+      m_O[c] = Boundary;
+    }
+    else
+    {
+      m_O[c] = NonManifold;
+    }
+  }
+  m_VertexCorner.assign(numberOfPoints, Invalid);
+  m_State.assign(numberOfPoints, RemesherFree);
+  m_Valence.assign(numberOfPoints, 0);
+  for (std::size_t i = 0; i < numberOfPoints; ++i)
+  {
+    if (offsets[i] == offsets[i + 1])
+    {
+      m_State[i] = RemesherRemoved; // used by no triangle: dropped
+    }
+    else
+    {
+      m_VertexCorner[i] = corners[offsets[i]];
+    }
+  }
+  for (std::size_t c = 0; c < numberOfCorners; ++c)
+  {
+    const IndexType a = m_V[c];
+    const IndexType b = m_V[Next(static_cast<IndexType>(c))];
+    if (m_O[c] == NonManifold)
+    {
+      m_State[a] = RemesherFrozen;
+      m_State[b] = RemesherFrozen;
+    }
+    else if (m_O[c] == Boundary)
+    {
+      m_State[a] = std::max<uint8_t>(m_State[a], RemesherBoundary);
+      m_State[b] = std::max<uint8_t>(m_State[b], RemesherBoundary);
+    }
+    if (m_O[c] < 0 || static_cast<int64_t>(c) < m_O[c])
+    {
+      ++m_Valence[a];
+      ++m_Valence[b];
+    }
+  }
+  // A vertex whose corners do not form one fan is non-manifold: frozen.
+  for (std::size_t i = 0; i < numberOfPoints; ++i)
+  {
+    if (m_State[i] == RemesherFree || m_State[i] == RemesherBoundary)
+    {
+      if (!this->Ring(static_cast<IndexType>(i), m_RingA, &m_CornersA) ||
+          m_CornersA.size() != offsets[i + 1] - offsets[i])
+      {
+        m_State[i] = RemesherFrozen;
+      }
+    }
+  }
+  // Start the ring walk of a boundary vertex anywhere: Ring() finds the end.
+}
+
+inline bool
+DeformableMeshRemesher::Ring(IndexType v, std::vector<IndexType> & neighbours, std::vector<IndexType> * corners) const
+{
+  neighbours.clear();
+  if (corners)
+  {
+    corners->clear();
+  }
+  const IndexType start = m_VertexCorner[v];
+  if (start == Invalid || m_State[v] >= RemesherFrozen)
+  {
+    return false;
+  }
+  // Back to the first corner of the fan: reverse swing c -> Next(O[c]).
+  IndexType   c = start;
+  std::size_t guard = 0;
+  while (true)
+  {
+    const int64_t o = m_O[c];
+    if (o == NonManifold)
+    {
+      return false;
+    }
+    if (o == Boundary)
+    {
+      break;
+    }
+    c = Next(static_cast<IndexType>(o));
+    if (c == start)
+    {
+      break;
+    }
+    if (++guard > 1000)
+    {
+      return false;
+    }
+  }
+  const IndexType first = c;
+  guard = 0;
+  while (true)
+  {
+    if (corners)
+    {
+      corners->push_back(c);
+    }
+    neighbours.push_back(m_V[Next(c)]);
+    const IndexType p = Prev(c);
+    const int64_t   o = m_O[p];
+    if (o == NonManifold)
+    {
+      return false;
+    }
+    if (o == Boundary)
+    {
+      neighbours.push_back(m_V[p]);
+      break;
+    }
+    c = static_cast<IndexType>(o);
+    if (c == first)
+    {
+      break;
+    }
+    if (++guard > 1000)
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+inline void
+DeformableMeshRemesher::Split(IndexType c)
+{
+  const IndexType a = m_V[c];
+  const IndexType nc = Next(c);
+  const IndexType pc = Prev(c);
+  const IndexType b = m_V[nc];
+  const IndexType C = m_V[pc];
+  const int64_t   o = m_O[c];
+  const double *  pa = m_X.data() + 3 * static_cast<std::size_t>(a);
+  const double *  pb = m_X.data() + 3 * static_cast<std::size_t>(b);
+  const double    mid[3] = { 0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1]), 0.5 * (pa[2] + pb[2]) };
+  const IndexType m = this->NewVertex(mid, a);
+  if (o == Boundary)
+  {
+    m_State[m] = RemesherBoundary;
+  }
+
+  // Triangle t = (a, b, C) becomes (a, m, C); new t2 = (m, b, C).
+  const auto    t2 = static_cast<IndexType>(m_V.size());
+  const int64_t oldNext = m_O[nc]; // twin of b -> C
+  m_V[nc] = m;
+  m_V.push_back(m);
+  m_V.push_back(b);
+  m_V.push_back(C);
+  m_O.push_back(Boundary); // m -> b, set below
+  m_O.push_back(oldNext);  // b -> C
+  m_O.push_back(nc);       // C -> m
+  m_O[nc] = t2 + 2;        // m -> C
+  if (oldNext >= 0)
+  {
+    m_O[oldNext] = t2 + 1;
+  }
+  if (m_VertexCorner[b] == nc)
+  {
+    m_VertexCorner[b] = t2 + 1;
+  }
+  m_VertexCorner[m] = t2;
+  ++m_Valence[C];
+  m_Valence[m] = 3;
+
+  if (o >= 0)
+  {
+    // Triangle u = (b, a, D) with corner o at b becomes (b, m, D); new
+    // u2 = (m, a, D).
+    const auto      oc = static_cast<IndexType>(o);
+    const IndexType no = Next(oc);
+    const IndexType po = Prev(oc);
+    const IndexType D = m_V[po];
+    const auto      u2 = static_cast<IndexType>(m_V.size());
+    const int64_t   oldNextU = m_O[no]; // twin of a -> D
+    m_V[no] = m;
+    m_V.push_back(m);
+    m_V.push_back(a);
+    m_V.push_back(D);
+    m_O.push_back(c);        // m -> a
+    m_O.push_back(oldNextU); // a -> D
+    m_O.push_back(no);       // D -> m
+    m_O[no] = u2 + 2;
+    if (oldNextU >= 0)
+    {
+      m_O[oldNextU] = u2 + 1;
+    }
+    m_O[c] = u2;  // a -> m
+    m_O[oc] = t2; // b -> m
+    m_O[t2] = oc; // m -> b
+    if (m_VertexCorner[a] == no)
+    {
+      m_VertexCorner[a] = u2 + 1;
+    }
+    ++m_Valence[D];
+    m_Valence[m] = 4;
+  }
+  else
+  {
+    m_O[c] = Boundary;
+    m_O[t2] = Boundary;
+  }
+  ++m_Statistics.splits;
+}
+
+inline bool
+DeformableMeshRemesher::SplitPass()
+{
+  // The long edges of the mesh as it is, longest first: splitting a long
+  // edge before the shorter ones around it avoids fans of thin triangles.
+  std::vector<std::pair<double, IndexType>> candidates;
+  for (IndexType c = 0; c < m_V.size(); ++c)
+  {
+    if (m_V[c] == Invalid)
+    {
+      continue;
+    }
+    const int64_t o = m_O[c];
+    if (o == NonManifold || (o >= 0 && o < static_cast<int64_t>(c)))
+    {
+      continue;
+    }
+    const IndexType a = m_V[c];
+    const IndexType b = m_V[Next(c)];
+    if (m_State[a] == RemesherFrozen || m_State[b] == RemesherFrozen)
+    {
+      continue;
+    }
+    const double length2 = this->Length2(a, b);
+    if (length2 > m_Max2)
+    {
+      candidates.emplace_back(length2, c);
+    }
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const auto & p, const auto & q) {
+    return p.first > q.first || (p.first == q.first && p.second < q.second);
+  });
+  for (const auto & candidate : candidates)
+  {
+    // A split changes the edges of the corners of its triangles: check again.
+    const IndexType c = candidate.second;
+    if (m_O[c] != NonManifold && this->Length2(m_V[c], m_V[Next(c)]) > m_Max2)
+    {
+      this->Split(c);
+    }
+  }
+  return !candidates.empty();
+}
+
+inline bool
+DeformableMeshRemesher::TryCollapse(IndexType c, bool fromTwin)
+{
+  const int64_t o = m_O[c];
+  if (o < 0)
+  {
+    return false;
+  }
+  const IndexType a = m_V[c];
+  const IndexType b = m_V[Next(c)];
+  if (m_State[b] != RemesherFree)
+  {
+    // Into a boundary end-point, which stays where it is: from its side.
+    return m_State[a] == RemesherFree && m_State[b] == RemesherBoundary && !fromTwin &&
+           this->TryCollapse(static_cast<IndexType>(o), true);
+  }
+  if (m_State[a] != RemesherFree && m_State[a] != RemesherBoundary)
+  {
+    return false;
+  }
+  const bool      keepA = m_State[a] == RemesherBoundary;
+  const IndexType C = m_V[Prev(c)];
+  const IndexType D = m_V[Prev(static_cast<IndexType>(o))];
+  if (C == D || m_Valence[C] <= 3 || m_Valence[D] <= 3)
+  {
+    return false;
+  }
+  if (!this->Ring(a, m_RingA, &m_CornersA) || !this->Ring(b, m_RingB, &m_CornersB))
+  {
+    return false;
+  }
+  // Link condition: the common neighbours of a and b are C and D only.
+  for (const IndexType w : m_RingA)
+  {
+    if (w != C && w != D && w != b && std::find(m_RingB.begin(), m_RingB.end(), w) != m_RingB.end())
+    {
+      return false;
+    }
+  }
+  if (m_RingA.size() + m_RingB.size() < 8)
+  {
+    return false; // the result would have a vertex of valence below 3
+  }
+  const double *  pa = m_X.data() + 3 * static_cast<std::size_t>(a);
+  const double *  pb = m_X.data() + 3 * static_cast<std::size_t>(b);
+  const IndexType tc = c / 3;
+  const IndexType to = static_cast<IndexType>(o) / 3;
+  // The merged vertex goes to the midpoint, or else to either end-point.
+  const auto acceptable = [&](const double * p) {
+    // No edge longer than the maximum.
+    for (const std::vector<IndexType> * ring : { &m_RingA, &m_RingB })
+    {
+      for (const IndexType w : *ring)
+      {
+        if (w == a || w == b)
+        {
+          continue;
+        }
+        const double * q = m_X.data() + 3 * static_cast<std::size_t>(w);
+        const double   d0 = q[0] - p[0];
+        const double   d1 = q[1] - p[1];
+        const double   d2 = q[2] - p[2];
+        if (d0 * d0 + d1 * d1 + d2 * d2 > m_Max2)
+        {
+          return false;
+        }
+      }
+    }
+    // No triangle turned around: each triangle of a or b other than the two
+    // removed stays within 60 degrees of its former direction, and is not
+    // degenerate.
+    for (const std::vector<IndexType> * corners : { &m_CornersA, &m_CornersB })
+    {
+      for (const IndexType k : *corners)
+      {
+        if (k / 3 == tc || k / 3 == to)
+        {
+          continue;
+        }
+        const IndexType q1 = m_V[Next(k)];
+        const IndexType q2 = m_V[Prev(k)];
+        double          before[3];
+        double          after[3];
+        this->TriangleNormal(m_V[k], q1, q2, before);
+        this->TriangleNormal(
+          p, m_X.data() + 3 * static_cast<std::size_t>(q1), m_X.data() + 3 * static_cast<std::size_t>(q2), after);
+        const double dot = before[0] * after[0] + before[1] * after[1] + before[2] * after[2];
+        const double nb = std::sqrt(before[0] * before[0] + before[1] * before[1] + before[2] * before[2]);
+        const double na = std::sqrt(after[0] * after[0] + after[1] * after[1] + after[2] * after[2]);
+        if (!(dot > 0.5 * nb * na) || !(na > 1e-6 * m_Min2))
+        {
+          return false;
+        }
+      }
+    }
+    return true;
+  };
+  double mid[3] = { 0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1]), 0.5 * (pa[2] + pb[2]) };
+  if (keepA)
+  {
+    std::copy(pa, pa + 3, mid);
+    if (!acceptable(mid))
+    {
+      return false;
+    }
+  }
+  else if (!acceptable(mid))
+  {
+    if (acceptable(pa))
+    {
+      std::copy(pa, pa + 3, mid);
+    }
+    else if (acceptable(pb))
+    {
+      std::copy(pb, pb + 3, mid);
+    }
+    else
+    {
+      return false;
+    }
+  }
+
+  // Collapse: b's corners become a's, the two triangles go, their outer
+  // half-edges are glued.
+  for (const IndexType k : m_CornersB)
+  {
+    m_V[k] = a;
+  }
+  const IndexType nc = Next(c);
+  const IndexType pc = Prev(c);
+  const auto      oc = static_cast<IndexType>(o);
+  const IndexType no = Next(oc);
+  const IndexType po = Prev(oc);
+  const int64_t   x = m_O[nc]; // C -> b
+  const int64_t   y = m_O[pc]; // a -> C
+  const int64_t   z = m_O[no]; // D -> a
+  const int64_t   w = m_O[po]; // b -> D
+  // x and w are interior (b is free); y and z may be boundary half-edges
+  // when a is a boundary vertex.
+  m_O[x] = y;
+  if (y >= 0)
+  {
+    m_O[y] = x;
+  }
+  m_O[w] = z;
+  if (z >= 0)
+  {
+    m_O[z] = w;
+  }
+  for (const IndexType k : { c, nc, pc, oc, no, po })
+  {
+    m_V[k] = Invalid;
+    m_O[k] = NonManifold;
+  }
+  m_VertexCorner[a] = static_cast<IndexType>(y >= 0 ? y : w);
+  m_VertexCorner[C] = static_cast<IndexType>(x);
+  m_VertexCorner[D] = z >= 0 ? static_cast<IndexType>(z) : Next(static_cast<IndexType>(w));
+  m_VertexCorner[b] = Invalid;
+  m_Valence[a] = m_Valence[a] + m_Valence[b] - 4;
+  --m_Valence[C];
+  --m_Valence[D];
+  m_State[b] = RemesherRemoved;
+  std::copy(mid, mid + 3, m_X.data() + 3 * static_cast<std::size_t>(a));
+  ++m_Statistics.collapses;
+  return true;
+}
+
+inline void
+DeformableMeshRemesher::CollapsePass()
+{
+  for (IndexType c = 0; c < m_V.size(); ++c)
+  {
+    if (m_V[c] == Invalid || m_O[c] < static_cast<int64_t>(c))
+    {
+      continue; // removed, boundary, frozen, or seen from its twin
+    }
+    // A short edge that cannot be collapsed is flipped to the longer
+    // diagonal when that one is within the band.
+    if (this->Length2(m_V[c], m_V[Next(c)]) < m_Min2 && !this->TryCollapse(c))
+    {
+      this->TryFlip(c, true);
+    }
+  }
+}
+
+inline bool
+DeformableMeshRemesher::TryFlip(IndexType c, bool lengthen)
+{
+  const int64_t o = m_O[c];
+  if (o < 0)
+  {
+    return false;
+  }
+  const auto      oc = static_cast<IndexType>(o);
+  const IndexType nc = Next(c);
+  const IndexType pc = Prev(c);
+  const IndexType no = Next(oc);
+  const IndexType po = Prev(oc);
+  const IndexType a = m_V[c];
+  const IndexType b = m_V[nc];
+  const IndexType C = m_V[pc];
+  const IndexType D = m_V[po];
+  if (C == D)
+  {
+    return false;
+  }
+  for (const IndexType v : { a, b, C, D })
+  {
+    if (m_State[v] >= RemesherFrozen)
+    {
+      return false;
+    }
+  }
+  const auto target = [this](IndexType v) { return m_State[v] == RemesherBoundary ? 4 : 6; };
+  const auto deviation = [&](int da, int db, int dc, int dd) {
+    return std::abs(m_Valence[a] + da - target(a)) + std::abs(m_Valence[b] + db - target(b)) +
+           std::abs(m_Valence[C] + dc - target(C)) + std::abs(m_Valence[D] + dd - target(D));
+  };
+  if (lengthen)
+  {
+    const double newLength2 = this->Length2(C, D);
+    if (!(newLength2 > this->Length2(a, b) && newLength2 <= m_Max2) ||
+        deviation(-1, -1, 1, 1) > deviation(0, 0, 0, 0) + 2)
+    {
+      return false;
+    }
+  }
+  else if (deviation(-1, -1, 1, 1) >= deviation(0, 0, 0, 0))
+  {
+    return false;
+  }
+  if (m_Valence[a] <= 3 || m_Valence[b] <= 3)
+  {
+    return false;
+  }
+  // The new edge C - D must not exist.
+  if (!this->Ring(C, m_RingA, nullptr) || std::find(m_RingA.begin(), m_RingA.end(), D) != m_RingA.end())
+  {
+    return false;
+  }
+  // Geometry: the new triangles (a, D, C) and (b, C, D) keep the side of
+  // the old ones and do not fold onto each other.
+  double n1[3];
+  double n2[3];
+  double m1[3];
+  double m2[3];
+  this->TriangleNormal(a, b, C, n1);
+  this->TriangleNormal(b, a, D, n2);
+  this->TriangleNormal(a, D, C, m1);
+  this->TriangleNormal(b, C, D, m2);
+  const double old[3] = { n1[0] + n2[0], n1[1] + n2[1], n1[2] + n2[2] };
+  const auto   dot = [](const double * u, const double * v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; };
+  const auto   norm = [&](const double * u) { return std::sqrt(dot(u, u)); };
+  if (!(dot(m1, old) > 0.0) || !(dot(m2, old) > 0.0))
+  {
+    return false;
+  }
+  const double oldCos = dot(n1, n2) / (norm(n1) * norm(n2));
+  const double newCos = dot(m1, m2) / (norm(m1) * norm(m2));
+  if (!(newCos > 0.5 || newCos >= oldCos))
+  {
+    return false;
+  }
+
+  // t = (a, D, C), u = (b, C, D).
+  const int64_t a1 = m_O[no]; // twin of a -> D
+  const int64_t b1 = m_O[nc]; // twin of b -> C
+  m_V[nc] = D;
+  m_V[no] = C;
+  m_O[c] = a1;
+  if (a1 >= 0)
+  {
+    m_O[a1] = c;
+  }
+  m_O[oc] = b1;
+  if (b1 >= 0)
+  {
+    m_O[b1] = oc;
+  }
+  m_O[nc] = no;
+  m_O[no] = nc;
+  m_VertexCorner[a] = c;
+  m_VertexCorner[b] = oc;
+  m_VertexCorner[C] = pc;
+  m_VertexCorner[D] = po;
+  --m_Valence[a];
+  --m_Valence[b];
+  ++m_Valence[C];
+  ++m_Valence[D];
+  ++m_Statistics.flips;
+  return true;
+}
+
+inline void
+DeformableMeshRemesher::FlipPass()
+{
+  for (IndexType c = 0; c < m_V.size(); ++c)
+  {
+    if (m_V[c] == Invalid || m_O[c] < static_cast<int64_t>(c))
+    {
+      continue;
+    }
+    this->TryFlip(c);
+  }
+}
+
+inline void
+DeformableMeshRemesher::Relax()
+{
+  const std::size_t   numberOfPoints = m_State.size();
+  std::vector<double> moved(m_X);
+  for (std::size_t i = 0; i < numberOfPoints; ++i)
+  {
+    if (m_State[i] != RemesherFree || !this->Ring(static_cast<IndexType>(i), m_RingA, &m_CornersA))
+    {
+      continue;
+    }
+    const double * p = m_X.data() + 3 * i;
+    double         centroid[3] = { 0.0, 0.0, 0.0 };
+    double         normal[3] = { 0.0, 0.0, 0.0 };
+    for (const IndexType w : m_RingA)
+    {
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        centroid[d] += m_X[3 * static_cast<std::size_t>(w) + d];
+      }
+    }
+    for (const IndexType k : m_CornersA)
+    {
+      double n[3];
+      this->TriangleNormal(m_V[k], m_V[Next(k)], m_V[Prev(k)], n);
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        normal[d] += n[d];
+      }
+    }
+    const double length = std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+    if (!(length > 0.0))
+    {
+      continue;
+    }
+    double step[3];
+    double along = 0.0;
+    for (unsigned int d = 0; d < 3; ++d)
+    {
+      normal[d] /= length;
+      step[d] = centroid[d] / static_cast<double>(m_RingA.size()) - p[d];
+      along += step[d] * normal[d];
+    }
+    double q[3];
+    for (unsigned int d = 0; d < 3; ++d)
+    {
+      q[d] = p[d] + 0.5 * (step[d] - along * normal[d]);
+    }
+    // Refuse a move that turns one of the vertex's triangles around.
+    bool keeps = true;
+    for (const IndexType k : m_CornersA)
+    {
+      const double * q1 = m_X.data() + 3 * static_cast<std::size_t>(m_V[Next(k)]);
+      const double * q2 = m_X.data() + 3 * static_cast<std::size_t>(m_V[Prev(k)]);
+      double         before[3];
+      double         after[3];
+      this->TriangleNormal(p, q1, q2, before);
+      this->TriangleNormal(q, q1, q2, after);
+      if (!(before[0] * after[0] + before[1] * after[1] + before[2] * after[2] > 0.0))
+      {
+        keeps = false;
+        break;
+      }
+    }
+    if (keeps)
+    {
+      std::copy(q, q + 3, moved.data() + 3 * i);
+      ++m_Statistics.relaxed;
+    }
+  }
+  m_X.swap(moved);
+}
+
+inline bool
+DeformableMeshRemesher::MoveKeepsBand(IndexType v, const double * q, IndexType other) const
+{
+  std::vector<IndexType> ring;
+  std::vector<IndexType> corners;
+  if (m_State[v] != RemesherFree || !this->Ring(v, ring, &corners))
+  {
+    return false;
+  }
+  for (const IndexType w : ring)
+  {
+    if (w == other)
+    {
+      continue;
+    }
+    const double * p = m_X.data() + 3 * static_cast<std::size_t>(w);
+    const double   d2 = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]);
+    if (d2 < m_Min2 || d2 > m_Max2)
+    {
+      return false;
+    }
+  }
+  const double * p = m_X.data() + 3 * static_cast<std::size_t>(v);
+  for (const IndexType k : corners)
+  {
+    const double * q1 = m_X.data() + 3 * static_cast<std::size_t>(m_V[Next(k)]);
+    const double * q2 = m_X.data() + 3 * static_cast<std::size_t>(m_V[Prev(k)]);
+    double         before[3];
+    double         after[3];
+    this->TriangleNormal(p, q1, q2, before);
+    this->TriangleNormal(q, q1, q2, after);
+    const double dot = before[0] * after[0] + before[1] * after[1] + before[2] * after[2];
+    const double nb = std::sqrt(before[0] * before[0] + before[1] * before[1] + before[2] * before[2]);
+    const double na = std::sqrt(after[0] * after[0] + after[1] * after[1] + after[2] * after[2]);
+    if (!(dot > 0.5 * nb * na))
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+inline void
+DeformableMeshRemesher::LengthenPass()
+{
+  const double minimum = std::sqrt(m_Min2);
+  for (IndexType c = 0; c < m_V.size(); ++c)
+  {
+    if (m_V[c] == Invalid || m_O[c] < static_cast<int64_t>(c))
+    {
+      continue;
+    }
+    const IndexType a = m_V[c];
+    const IndexType b = m_V[Next(c)];
+    const double    length = std::sqrt(this->Length2(a, b));
+    if (!(length < minimum) || !(length > 0.0))
+    {
+      continue;
+    }
+    double *     pa = m_X.data() + 3 * static_cast<std::size_t>(a);
+    double *     pb = m_X.data() + 3 * static_cast<std::size_t>(b);
+    const double u[3] = { (pb[0] - pa[0]) / length, (pb[1] - pa[1]) / length, (pb[2] - pa[2]) / length };
+    const double missing = 1.01 * minimum - length;
+    // Both end-points half the way, or one of them all the way.
+    const double shares[3][2] = { { 0.5, 0.5 }, { 1.0, 0.0 }, { 0.0, 1.0 } };
+    for (const auto & share : shares)
+    {
+      double qa[3];
+      double qb[3];
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        qa[d] = pa[d] - share[0] * missing * u[d];
+        qb[d] = pb[d] + share[1] * missing * u[d];
+      }
+      if ((share[0] == 0.0 || this->MoveKeepsBand(a, qa, b)) && (share[1] == 0.0 || this->MoveKeepsBand(b, qb, a)))
+      {
+        std::copy(qa, qa + 3, pa);
+        std::copy(qb, qb + 3, pb);
+        break;
+      }
+    }
+  }
+}
+
+inline void
+DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<IndexType> & triangles)
+{
+  // Order: the input vertices kept, in order, each followed by the vertices
+  // split from its edges (a counting sort on the input ancestor).
+  const std::size_t      numberOfPoints = m_State.size();
+  std::vector<IndexType> root(numberOfPoints);
+  for (std::size_t i = 0; i < numberOfPoints; ++i)
+  {
+    root[i] = i < m_InputPoints ? static_cast<IndexType>(i) : root[m_Parents[i]];
+  }
+  std::vector<IndexType> start(m_InputPoints + 1, 0);
+  for (std::size_t i = 0; i < numberOfPoints; ++i)
+  {
+    if (m_State[i] != RemesherRemoved)
+    {
+      ++start[root[i] + 1];
+    }
+  }
+  for (std::size_t i = 0; i < m_InputPoints; ++i)
+  {
+    start[i + 1] += start[i];
+  }
+  const IndexType        kept = start[m_InputPoints];
+  std::vector<IndexType> newIndex(numberOfPoints, Invalid);
+  std::vector<IndexType> parents(kept);
+  coordinates.resize(3 * static_cast<std::size_t>(kept));
+  for (std::size_t i = 0; i < numberOfPoints; ++i)
+  {
+    if (m_State[i] != RemesherRemoved)
+    {
+      const IndexType k = start[root[i]]++;
+      newIndex[i] = k;
+      parents[k] = i < m_InputPoints ? static_cast<IndexType>(i) : m_Parents[i];
+      std::copy(m_X.data() + 3 * i, m_X.data() + 3 * i + 3, coordinates.data() + 3 * static_cast<std::size_t>(k));
+    }
+  }
+  // A split vertex's parent may be another split vertex: follow to the input.
+  for (IndexType & p : parents)
+  {
+    while (p >= m_InputPoints)
+    {
+      p = m_Parents[p];
+    }
+  }
+  m_Parents.swap(parents);
+  m_Edges.clear();
+  m_EdgesUnique = true;
+  for (std::size_t c = 0; c < m_V.size(); ++c)
+  {
+    const int64_t o = m_O[c];
+    if (m_V[c] != Invalid && (o < 0 || static_cast<int64_t>(c) < o))
+    {
+      const uint64_t a = newIndex[m_V[c]];
+      const uint64_t b = newIndex[m_V[Next(static_cast<IndexType>(c))]];
+      m_Edges.push_back(std::min(a, b) << 32 | std::max(a, b));
+      m_EdgesUnique = m_EdgesUnique && o != NonManifold;
+    }
+  }
+  triangles.clear();
+  for (std::size_t c = 0; c < m_V.size(); c += 3)
+  {
+    if (m_V[c] != Invalid)
+    {
+      triangles.push_back(newIndex[m_V[c]]);
+      triangles.push_back(newIndex[m_V[c + 1]]);
+      triangles.push_back(newIndex[m_V[c + 2]]);
+    }
+  }
+}
+
+inline DeformableMeshRemesher::Statistics
+DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
+                               std::size_t              numberOfPoints,
+                               std::vector<IndexType> & triangles)
+{
+  if (!(m_TargetEdgeLength > 0.0 && std::isfinite(m_TargetEdgeLength)))
+  {
+    itkGenericExceptionMacro("DeformableMeshRemesher: the target edge length must be finite and positive; it is "
+                             << m_TargetEdgeLength << ".");
+  }
+  if (!(m_MinimumRatio > 0.0 && m_MinimumRatio < m_MaximumRatio && std::isfinite(m_MaximumRatio)))
+  {
+    itkGenericExceptionMacro("DeformableMeshRemesher: the edge length ratios must satisfy 0 < minimum < maximum; they "
+                             "are "
+                             << m_MinimumRatio << " and " << m_MaximumRatio << ".");
+  }
+  if (triangles.size() % 3 != 0 || coordinates.size() < 3 * numberOfPoints ||
+      numberOfPoints >= std::numeric_limits<IndexType>::max() / 2)
+  {
+    itkGenericExceptionMacro("DeformableMeshRemesher: " << triangles.size() << " triangle indices and "
+                                                        << coordinates.size() << " coordinates for " << numberOfPoints
+                                                        << " points.");
+  }
+  for (const IndexType v : triangles)
+  {
+    if (v >= numberOfPoints)
+    {
+      itkGenericExceptionMacro("DeformableMeshRemesher: a triangle refers to point " << v << " of " << numberOfPoints
+                                                                                     << ".");
+    }
+  }
+  m_Statistics = Statistics{};
+  m_InputPoints = numberOfPoints;
+  m_Min2 = GetMinimumEdgeLength() * GetMinimumEdgeLength();
+  m_Max2 = GetMaximumEdgeLength() * GetMaximumEdgeLength();
+  m_X.assign(coordinates.begin(), coordinates.begin() + 3 * numberOfPoints);
+  m_V.assign(triangles.begin(), triangles.end());
+  m_Parents.resize(numberOfPoints);
+  std::iota(m_Parents.begin(), m_Parents.end(), IndexType{ 0 });
+  this->Build(numberOfPoints);
+
+  for (unsigned int pass = 0; pass < 16 && this->SplitPass(); ++pass)
+  {}
+  this->CollapsePass();
+  this->FlipPass();
+  for (unsigned int sweep = 0; sweep < m_RelaxationSweeps; ++sweep)
+  {
+    this->Relax();
+  }
+  for (unsigned int pass = 0; pass < 16 && this->SplitPass(); ++pass)
+  {}
+  this->CollapsePass();
+  this->LengthenPass();
+  this->Compact(coordinates, triangles);
+  return m_Statistics;
+}
+
+inline std::vector<DeformableMeshRemesher::IndexType>
+DeformableMeshRemesher::LocalityOrder(const double * coordinates, std::size_t numberOfPoints)
+{
+  double lower[3] = { std::numeric_limits<double>::max(),
+                      std::numeric_limits<double>::max(),
+                      std::numeric_limits<double>::max() };
+  double upper[3] = { std::numeric_limits<double>::lowest(),
+                      std::numeric_limits<double>::lowest(),
+                      std::numeric_limits<double>::lowest() };
+  for (std::size_t i = 0; i < numberOfPoints; ++i)
+  {
+    for (unsigned int d = 0; d < 3; ++d)
+    {
+      lower[d] = std::min(lower[d], coordinates[3 * i + d]);
+      upper[d] = std::max(upper[d], coordinates[3 * i + d]);
+    }
+  }
+  const double extent = std::max({ upper[0] - lower[0], upper[1] - lower[1], upper[2] - lower[2], 1e-300 });
+  const double scale = 2097151.0 / extent;
+  // Spreads the 21 bits of v two bits apart.
+  const auto spread = [](uint64_t v) {
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffULL;
+    v = (v | v << 16) & 0x1f0000ff0000ffULL;
+    v = (v | v << 8) & 0x100f00f00f00f00fULL;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+    v = (v | v << 2) & 0x1249249249249249ULL;
+    return v;
+  };
+  std::vector<uint64_t> keys(numberOfPoints);
+  for (std::size_t i = 0; i < numberOfPoints; ++i)
+  {
+    uint64_t code = 0;
+    for (unsigned int d = 0; d < 3; ++d)
+    {
+      const auto q =
+        static_cast<uint64_t>(std::max(0.0, std::min(2097151.0, (coordinates[3 * i + d] - lower[d]) * scale)));
+      code |= spread(q) << d;
+    }
+    keys[i] = code;
+  }
+  std::vector<IndexType> order(numberOfPoints);
+  std::iota(order.begin(), order.end(), IndexType{ 0 });
+  std::stable_sort(order.begin(), order.end(), [&keys](IndexType a, IndexType b) { return keys[a] < keys[b]; });
+  return order;
+}
+
+inline double
+DeformableMeshRemesher::FarEdgeFraction(const std::vector<IndexType> & triangles, std::size_t window)
+{
+  if (triangles.empty())
+  {
+    return 0.0;
+  }
+  std::size_t far = 0;
+  for (std::size_t t = 0; t + 2 < triangles.size(); t += 3)
+  {
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      const IndexType a = triangles[t + k];
+      const IndexType b = triangles[t + (k + 1) % 3];
+      far += (a > b ? a - b : b - a) > window;
+    }
+  }
+  return static_cast<double>(far) / static_cast<double>(triangles.size());
+}
+
+} // end namespace itk
+
+#endif

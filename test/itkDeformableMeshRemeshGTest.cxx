@@ -1,0 +1,702 @@
+/*=========================================================================
+ *
+ *  Copyright NumFOCUS
+ *
+ *  Licensed under the Apache License, Version 2.0 (the "License");
+ *  you may not use this file except in compliance with the License.
+ *  You may obtain a copy of the License at
+ *
+ *         http://www.apache.org/licenses/LICENSE-2.0.txt
+ *
+ *  Unless required by applicable law or agreed to in writing, software
+ *  distributed under the License is distributed on an "AS IS" BASIS,
+ *  WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+ *  See the License for the specific language governing permissions and
+ *  limitations under the License.
+ *
+ *=========================================================================*/
+
+// Issue 15 items 1, 2 and 5: the remesher on its own (known answers on flat
+// arrays), the filter's remeshing during the iteration and its iteration
+// contract with a changing mesh, the renumbering for locality.
+
+#include "itkDeformableMeshRemesher.h"
+#include "itkDeformableMeshFilter.h"
+#include "itkEllipsoidPhantom.h"
+#include "itkExternalForceImageFilter.h"
+#include "itkMesh.h"
+#include "edmTestUtilities.h"
+#include "gtest/gtest.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <set>
+#include <utility>
+#include <vector>
+
+namespace
+{
+using IndexType = itk::DeformableMeshRemesher::IndexType;
+using MeshType = itk::Mesh<double, 3>;
+using PointType = MeshType::PointType;
+
+struct FlatMesh
+{
+  std::vector<double>    x;
+  std::vector<IndexType> triangles;
+  std::size_t
+  Points() const
+  {
+    return x.size() / 3;
+  }
+};
+
+FlatMesh
+ToFlat(const MeshType * mesh)
+{
+  FlatMesh f;
+  for (auto it = mesh->GetPoints()->Begin(); it != mesh->GetPoints()->End(); ++it)
+  {
+    for (unsigned int d = 0; d < 3; ++d)
+    {
+      f.x.push_back(it.Value()[d]);
+    }
+  }
+  for (auto it = mesh->GetCells()->Begin(); it != mesh->GetCells()->End(); ++it)
+  {
+    if (it.Value()->GetNumberOfPoints() == 3)
+    {
+      const auto * ids = it.Value()->PointIdsBegin();
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        f.triangles.push_back(static_cast<IndexType>(ids[k]));
+      }
+    }
+  }
+  return f;
+}
+
+double
+EdgeLength(const FlatMesh & m, IndexType a, IndexType b)
+{
+  double s = 0.0;
+  for (unsigned int d = 0; d < 3; ++d)
+  {
+    const double e = m.x[3 * a + d] - m.x[3 * b + d];
+    s += e * e;
+  }
+  return std::sqrt(s);
+}
+
+/** Undirected edges with the number of triangles using them in each
+ * direction. */
+std::map<std::pair<IndexType, IndexType>, std::pair<int, int>>
+EdgeUses(const std::vector<IndexType> & triangles)
+{
+  std::map<std::pair<IndexType, IndexType>, std::pair<int, int>> uses;
+  for (std::size_t t = 0; t < triangles.size(); t += 3)
+  {
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      const IndexType a = triangles[t + k];
+      const IndexType b = triangles[t + (k + 1) % 3];
+      auto &          u = uses[{ std::min(a, b), std::max(a, b) }];
+      (a < b ? u.first : u.second) += 1;
+    }
+  }
+  return uses;
+}
+
+struct Topology
+{
+  std::size_t vertices{ 0 };
+  std::size_t edges{ 0 };
+  std::size_t faces{ 0 };
+  std::size_t boundaryEdges{ 0 };
+  std::size_t badEdges{ 0 }; // more than two triangles, or inconsistent orientation
+  std::size_t degenerate{ 0 };
+  long
+  Euler() const
+  {
+    return static_cast<long>(vertices) - static_cast<long>(edges) + static_cast<long>(faces);
+  }
+};
+
+Topology
+Analyse(const FlatMesh & m)
+{
+  Topology            t;
+  std::set<IndexType> used(m.triangles.begin(), m.triangles.end());
+  t.vertices = used.size();
+  t.faces = m.triangles.size() / 3;
+  for (const auto & e : EdgeUses(m.triangles))
+  {
+    ++t.edges;
+    const int total = e.second.first + e.second.second;
+    if (total == 1)
+    {
+      ++t.boundaryEdges;
+    }
+    else if (!(e.second.first == 1 && e.second.second == 1))
+    {
+      ++t.badEdges;
+    }
+  }
+  for (std::size_t f = 0; f < m.triangles.size(); f += 3)
+  {
+    const IndexType a = m.triangles[f];
+    const IndexType b = m.triangles[f + 1];
+    const IndexType c = m.triangles[f + 2];
+    t.degenerate += a == b || b == c || a == c;
+  }
+  return t;
+}
+
+/** Smallest angle of the mesh's triangles, degrees. */
+double
+SmallestAngle(const FlatMesh & m)
+{
+  double smallest = 180.0;
+  for (std::size_t f = 0; f < m.triangles.size(); f += 3)
+  {
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      const IndexType a = m.triangles[f + k];
+      const IndexType b = m.triangles[f + (k + 1) % 3];
+      const IndexType c = m.triangles[f + (k + 2) % 3];
+      double          u[3];
+      double          v[3];
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        u[d] = m.x[3 * b + d] - m.x[3 * a + d];
+        v[d] = m.x[3 * c + d] - m.x[3 * a + d];
+      }
+      const double cosine =
+        (u[0] * v[0] + u[1] * v[1] + u[2] * v[2]) /
+        std::sqrt((u[0] * u[0] + u[1] * u[1] + u[2] * u[2]) * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+      smallest = std::min(smallest, std::acos(std::max(-1.0, std::min(1.0, cosine))) * 180.0 / 3.14159265358979323846);
+    }
+  }
+  return smallest;
+}
+
+void
+EdgeLengthRange(const FlatMesh & m, double & shortest, double & longest)
+{
+  shortest = 1e300;
+  longest = 0.0;
+  for (const auto & e : EdgeUses(m.triangles))
+  {
+    const double l = EdgeLength(m, e.first.first, e.first.second);
+    shortest = std::min(shortest, l);
+    longest = std::max(longest, l);
+  }
+}
+
+/** A flat grid of n x n squares of side h in the plane z = 0, each cut into
+ * two triangles along alternating diagonals. */
+FlatMesh
+FlatGrid(unsigned int n, double h)
+{
+  FlatMesh m;
+  for (unsigned int j = 0; j <= n; ++j)
+  {
+    for (unsigned int i = 0; i <= n; ++i)
+    {
+      m.x.push_back(i * h);
+      m.x.push_back(j * h);
+      m.x.push_back(0.0);
+    }
+  }
+  const auto id = [n](unsigned int i, unsigned int j) { return static_cast<IndexType>(j * (n + 1) + i); };
+  for (unsigned int j = 0; j < n; ++j)
+  {
+    for (unsigned int i = 0; i < n; ++i)
+    {
+      if ((i + j) % 2 == 0)
+      {
+        m.triangles.insert(m.triangles.end(), { id(i, j), id(i + 1, j), id(i + 1, j + 1) });
+        m.triangles.insert(m.triangles.end(), { id(i, j), id(i + 1, j + 1), id(i, j + 1) });
+      }
+      else
+      {
+        m.triangles.insert(m.triangles.end(), { id(i, j), id(i + 1, j), id(i, j + 1) });
+        m.triangles.insert(m.triangles.end(), { id(i + 1, j), id(i + 1, j + 1), id(i, j + 1) });
+      }
+    }
+  }
+  return m;
+}
+
+/** The boundary of a flat mesh as a set of segments' points sampled: true
+ * when every boundary vertex lies on the square [0, s]^2's border and the
+ * border's corners are vertices. */
+bool
+BoundaryOnSquare(const FlatMesh & m, double s, std::size_t & boundaryVertices)
+{
+  std::set<IndexType> boundary;
+  for (const auto & e : EdgeUses(m.triangles))
+  {
+    if (e.second.first + e.second.second == 1)
+    {
+      boundary.insert(e.first.first);
+      boundary.insert(e.first.second);
+    }
+  }
+  boundaryVertices = boundary.size();
+  unsigned int corners = 0;
+  for (const IndexType v : boundary)
+  {
+    const double x = m.x[3 * v];
+    const double y = m.x[3 * v + 1];
+    const bool   onBorder = x == 0.0 || y == 0.0 || x == s || y == s;
+    if (!onBorder || m.x[3 * v + 2] != 0.0)
+    {
+      return false;
+    }
+    corners += (x == 0.0 || x == s) && (y == 0.0 || y == s);
+  }
+  return corners == 4;
+}
+} // namespace
+
+TEST(DeformableMeshRemesher, FlatOpenGridKeepsItsBoundaryExactly)
+{
+  // A grid of squares of side 1 remeshed to edges of 0.45: the boundary is
+  // split, never moved; the interior comes into the band.
+  FlatMesh                    m = FlatGrid(8, 1.0);
+  itk::DeformableMeshRemesher remesher;
+  remesher.SetTargetEdgeLength(0.45);
+  for (int round = 0; round < 6; ++round)
+  {
+    remesher.Remesh(m.x, m.Points(), m.triangles);
+    ASSERT_EQ(remesher.Parents().size(), m.Points());
+  }
+  const Topology t = Analyse(m);
+  EXPECT_EQ(t.badEdges, 0u);
+  EXPECT_EQ(t.degenerate, 0u);
+  EXPECT_EQ(t.Euler(), 1) << "a disc";
+  std::size_t boundaryVertices = 0;
+  EXPECT_TRUE(BoundaryOnSquare(m, 8.0, boundaryVertices));
+  // Each side of length 8 split until its pieces are below 4/3 x 0.45 = 0.6:
+  // 16 pieces of 0.5 per side.
+  EXPECT_EQ(boundaryVertices, 64u);
+  EXPECT_EQ(t.boundaryEdges, 64u);
+  for (std::size_t i = 0; i < m.Points(); ++i)
+  {
+    EXPECT_EQ(m.x[3 * i + 2], 0.0) << "the plane is kept";
+  }
+  double shortest = 0.0;
+  double longest = 0.0;
+  EdgeLengthRange(m, shortest, longest);
+  EXPECT_LE(longest, remesher.GetMaximumEdgeLength());
+  EXPECT_GE(shortest, 0.5 * remesher.GetMaximumEdgeLength());
+  EXPECT_GE(SmallestAngle(m), 25.0);
+}
+
+TEST(DeformableMeshRemesher, ClosedSphereStaysAClosedTwoManifoldWithEdgesInTheBand)
+{
+  PointType centre;
+  centre.Fill(0.0);
+  constexpr double radius = 10.0;
+  const auto       sphere = itk::MakeSphereMesh<MeshType>(centre, radius, 3); // 258 points, edges about 2.2
+  for (const double target : { 0.9, 3.5 })                                    // refine, coarsen
+  {
+    FlatMesh                    m = ToFlat(sphere);
+    itk::DeformableMeshRemesher remesher;
+    remesher.SetTargetEdgeLength(target);
+    for (int round = 0; round < 8; ++round)
+    {
+      remesher.Remesh(m.x, m.Points(), m.triangles);
+      // The deformable model keeps the vertices on the surface; here the
+      // projection onto the sphere does.
+      for (std::size_t i = 0; i < m.Points(); ++i)
+      {
+        const double r =
+          std::sqrt(m.x[3 * i] * m.x[3 * i] + m.x[3 * i + 1] * m.x[3 * i + 1] + m.x[3 * i + 2] * m.x[3 * i + 2]);
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          m.x[3 * i + d] *= radius / r;
+        }
+      }
+    }
+    const Topology t = Analyse(m);
+    EXPECT_EQ(t.badEdges, 0u) << target;
+    EXPECT_EQ(t.boundaryEdges, 0u) << target;
+    EXPECT_EQ(t.degenerate, 0u) << target;
+    EXPECT_EQ(t.Euler(), 2) << target;
+    EXPECT_EQ(t.vertices, m.Points()) << "no unused point";
+    double shortest = 0.0;
+    double longest = 0.0;
+    EdgeLengthRange(m, shortest, longest);
+    // The projection lengthens edges by a factor of at most 1.01 here.
+    EXPECT_LE(longest, 1.01 * remesher.GetMaximumEdgeLength()) << target;
+    EXPECT_GE(shortest, 0.99 * 0.5 * remesher.GetMaximumEdgeLength()) << target;
+    EXPECT_GE(SmallestAngle(m), 25.0) << target;
+    // The area of the sphere over the area of an equilateral triangle of the
+    // target side, within the band.
+    const double expected = 4.0 * 3.14159265358979323846 * radius * radius / (std::sqrt(3.0) / 4.0 * target * target);
+    EXPECT_GT(t.faces, 0.5 * expected) << target;
+    EXPECT_LT(t.faces, 1.6 * expected) << target;
+    std::cout << "target " << target << ": " << t.vertices << " vertices, edges [" << shortest << ", " << longest
+              << "], smallest angle " << SmallestAngle(m) << std::endl;
+  }
+}
+
+TEST(DeformableMeshRemesher, LeavesNonManifoldPartsAlone)
+{
+  // Three triangles on one edge (0, 1), fins of a book: frozen, nothing
+  // changes even though their edges are far out of the band.
+  FlatMesh m;
+  m.x = { 0, 0, 0, 0, 0, 10, 5, 0, 5, -5, 0, 5, 0, 5, 5 };
+  m.triangles = { 0, 1, 2, 1, 0, 3, 0, 1, 4 };
+  const FlatMesh              before = m;
+  itk::DeformableMeshRemesher remesher;
+  remesher.SetTargetEdgeLength(1.0);
+  const auto statistics = remesher.Remesh(m.x, m.Points(), m.triangles);
+  EXPECT_EQ(statistics.splits + statistics.collapses + statistics.flips + statistics.relaxed, 0u);
+  EXPECT_EQ(m.x, before.x);
+  EXPECT_EQ(m.triangles, before.triangles);
+}
+
+TEST(DeformableMeshRemesher, RejectsABadTargetOrMissingPoints)
+{
+  FlatMesh                    m = FlatGrid(2, 1.0);
+  itk::DeformableMeshRemesher remesher;
+  for (const double bad :
+       { 0.0, -1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity() })
+  {
+    remesher.SetTargetEdgeLength(bad);
+    EXPECT_THROW(remesher.Remesh(m.x, m.Points(), m.triangles), itk::ExceptionObject) << bad;
+  }
+  remesher.SetTargetEdgeLength(1.0);
+  m.triangles.push_back(0);
+  m.triangles.push_back(1);
+  m.triangles.push_back(99);
+  EXPECT_THROW(remesher.Remesh(m.x, m.Points(), m.triangles), itk::ExceptionObject);
+}
+
+// ---------------------------------------------------------------------------
+// The filter with remeshing.
+namespace
+{
+using ImageType = itk::Image<float, 3>;
+using ForceImageType = itk::Image<itk::CovariantVector<float, 3>, 3>;
+using FilterType = itk::DeformableMeshFilter<MeshType, ForceImageType>;
+
+/** The issue's elongated object: a 96^3 binary image of the ellipsoid of
+ * radii (10, 10, 40) voxels at the image's centre, its force field (sigma
+ * 0.7 voxel: the tips, whose radius of curvature is 2.5 voxels, are one or
+ * two voxels wide) and a sphere of radius 8 at the centre. */
+struct ElongatedCase
+{
+  PointType                              centre;
+  std::unique_ptr<itk::EllipsoidPhantom> ellipsoid;
+  ForceImageType::Pointer                forces;
+  MeshType::Pointer                      sphere;
+
+  ElongatedCase()
+  {
+    centre.Fill(47.5);
+    itk::EllipsoidPhantom::VectorType radii;
+    radii[0] = 10.0;
+    radii[1] = 10.0;
+    radii[2] = 40.0;
+    ellipsoid = std::make_unique<itk::EllipsoidPhantom>(centre, radii);
+    ImageType::SizeType size;
+    size.Fill(96);
+    ImageType::SpacingType spacing;
+    spacing.Fill(1.0);
+    ImageType::PointType origin;
+    origin.Fill(0.0);
+    ImageType::DirectionType direction;
+    direction.SetIdentity();
+    const auto image = ellipsoid->MakeImage<ImageType>(size, spacing, origin, direction, 100.0f, 0.0f);
+    auto       force = itk::ExternalForceImageFilter<ImageType, ForceImageType>::New();
+    force->SetInput(image);
+    force->SetSigma(0.7);
+    force->Update();
+    forces = force->GetOutput();
+    forces->DisconnectPipeline();
+    sphere = itk::MakeSphereMesh<MeshType>(centre, 8.0, 4); // 1026 points, edges about 1 voxel
+  }
+
+  FilterType::Pointer
+  MakeFilter(double edgeLength, unsigned long iterations) const
+  {
+    auto filter = FilterType::New();
+    filter->SetInput(sphere);
+    filter->SetForceImage(forces);
+    filter->SetScaleFactor(0.35); // sigma / 2, as in the seed case
+    filter->SetElasticity(0.3);
+    filter->SetRigidity(0.05);
+    filter->SetBalloon(0.1);
+    filter->SetRemeshingEdgeLength(edgeLength);
+    filter->SetNumberOfIterations(iterations);
+    return filter;
+  }
+};
+
+const ElongatedCase &
+Elongated()
+{
+  static const ElongatedCase c;
+  return c;
+}
+
+FlatMesh
+OutputOf(FilterType * filter)
+{
+  return ToFlat(filter->GetOutput());
+}
+
+/** True when the two meshes have the same cells and the same points. */
+::testing::AssertionResult
+SameMesh(const MeshType * a, const MeshType * b)
+{
+  const FlatMesh fa = ToFlat(a);
+  const FlatMesh fb = ToFlat(b);
+  if (fa.triangles != fb.triangles)
+  {
+    return ::testing::AssertionFailure() << fa.triangles.size() / 3 << " and " << fb.triangles.size() / 3
+                                         << " triangles, not the same";
+  }
+  if (fa.x != fb.x)
+  {
+    return ::testing::AssertionFailure() << fa.Points() << " and " << fb.Points() << " points, not the same";
+  }
+  return ::testing::AssertionSuccess();
+}
+} // namespace
+
+TEST(DeformableMeshRemeshing, ElongatedObjectKeepsItsEdgesInTheBand)
+{
+  const ElongatedCase & c = Elongated();
+  constexpr double      target = 1.0;
+  constexpr unsigned    iterations = 600;
+
+  auto remeshed = c.MakeFilter(target, iterations);
+  remeshed->Update();
+  const FlatMesh m = OutputOf(remeshed);
+  const Topology t = Analyse(m);
+  EXPECT_EQ(t.badEdges, 0u);
+  EXPECT_EQ(t.boundaryEdges, 0u);
+  EXPECT_EQ(t.Euler(), 2);
+  EXPECT_EQ(remeshed->GetNumberOfRemeshings(), iterations / 10);
+  double shortest = 0.0;
+  double longest = 0.0;
+  EdgeLengthRange(m, shortest, longest);
+  double mean = 0.0;
+  double maximum = 0.0;
+  c.ellipsoid->MeasureDistance(remeshed->GetOutput(), mean, maximum);
+  const double angle = SmallestAngle(m);
+  std::cout << "remeshed: " << m.Points() << " points, edges [" << shortest << ", " << longest << "], smallest angle "
+            << angle << " deg, mean distance " << mean << ", max " << maximum << std::endl;
+  EXPECT_GE(shortest, 2.0 / 3.0 * target);
+  EXPECT_LE(longest, 4.0 / 3.0 * target);
+  EXPECT_GE(angle, 20.0);
+  EXPECT_LE(mean, 0.15);
+  EXPECT_LE(maximum, 0.5);
+
+  // Without remeshing the triangles of the poles stretch.
+  auto plain = c.MakeFilter(0.0, iterations);
+  plain->Update();
+  const FlatMesh p = OutputOf(plain);
+  double         poleLongest = 0.0;
+  for (const auto & e : EdgeUses(p.triangles))
+  {
+    const IndexType a = e.first.first;
+    const IndexType b = e.first.second;
+    if (std::abs(p.x[3 * a + 2] - c.centre[2]) > 30.0 || std::abs(p.x[3 * b + 2] - c.centre[2]) > 30.0)
+    {
+      poleLongest = std::max(poleLongest, EdgeLength(p, a, b));
+    }
+  }
+  double plainMean = 0.0;
+  double plainMaximum = 0.0;
+  c.ellipsoid->MeasureDistance(plain->GetOutput(), plainMean, plainMaximum);
+  std::cout << "not remeshed: longest edge near the poles " << poleLongest << ", mean distance " << plainMean
+            << ", max " << plainMaximum << std::endl;
+  EXPECT_GT(poleLongest, 3.0 * target);
+}
+
+TEST(DeformableMeshRemeshing, ContinuationAbortAndResetGiveTheSameMeshAcrossRemeshings)
+{
+  // 35 iterations, remeshing after 10, 20 and 30: all at once, one step per
+  // update, aborted and resumed, and again from zero: the same mesh.
+  const ElongatedCase & c = Elongated();
+  auto                  once = c.MakeFilter(1.0, 35);
+  once->Update();
+  ASSERT_EQ(once->GetNumberOfRemeshings(), 3u);
+  ASSERT_NE(once->GetOutput()->GetNumberOfPoints(), c.sphere->GetNumberOfPoints()) << "the mesh changed";
+
+  auto stepwise = c.MakeFilter(1.0, 0);
+  stepwise->SetIterateFromZero(false);
+  std::size_t events = 0;
+  bool        consistent = true;
+  stepwise->AddObserver(itk::IterationEvent(), [&](const itk::EventObject &) {
+    ++events;
+    // The current mesh is whole: cells refer to its points, diagnostics are
+    // sized to it.
+    const MeshType * output = stepwise->GetOutput();
+    const auto       n = output->GetNumberOfPoints();
+    for (auto it = output->GetCells()->Begin(); it != output->GetCells()->End(); ++it)
+    {
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        consistent = consistent && it.Value()->PointIdsBegin()[k] < n;
+      }
+    }
+    consistent = consistent && stepwise->GetDisplacementMagnitudes().size() == n &&
+                 stepwise->GetInternalForceMagnitudes().size() == n &&
+                 (output->GetPointData() == nullptr || output->GetPointData()->Size() == 0);
+  });
+  for (unsigned long i = 1; i <= 35; ++i)
+  {
+    stepwise->SetNumberOfIterations(i);
+    stepwise->Update();
+    ASSERT_EQ(stepwise->GetCurrentIteration(), i);
+    ASSERT_EQ(stepwise->GetNumberOfRemeshings(), i / 10);
+  }
+  EXPECT_EQ(events, 35u) << "one event per step";
+  EXPECT_TRUE(consistent);
+  EXPECT_TRUE(SameMesh(once->GetOutput(), stepwise->GetOutput()));
+
+  // Aborted after iteration 15, resumed.
+  auto aborted = c.MakeFilter(1.0, 35);
+  aborted->SetIterateFromZero(false);
+  const unsigned long tag = aborted->AddObserver(itk::IterationEvent(), [&](const itk::EventObject &) {
+    if (aborted->GetCurrentIteration() == 15)
+    {
+      aborted->SetAbortGenerateData(true);
+    }
+  });
+  aborted->Update();
+  EXPECT_EQ(aborted->GetCurrentIteration(), 15u);
+  EXPECT_EQ(aborted->GetNumberOfRemeshings(), 1u);
+  aborted->RemoveObserver(tag);
+  aborted->SetAbortGenerateData(false);
+  aborted->Modified();
+  aborted->Update();
+  EXPECT_EQ(aborted->GetCurrentIteration(), 35u);
+  EXPECT_TRUE(SameMesh(once->GetOutput(), aborted->GetOutput()));
+
+  // A reset (IterateFromZero on) starts again from the input's 1026 points.
+  once->SetNumberOfIterations(5);
+  once->Update();
+  EXPECT_EQ(once->GetOutput()->GetNumberOfPoints(), c.sphere->GetNumberOfPoints());
+  EXPECT_EQ(once->GetNumberOfRemeshings(), 0u);
+  once->SetNumberOfIterations(0);
+  once->Update();
+  EXPECT_TRUE(SameMesh(once->GetOutput(), c.sphere)) << "0 iterations: the input";
+}
+
+TEST(DeformableMeshRemeshing, RejectsABadEdgeLengthIntervalOrCells)
+{
+  const ElongatedCase & c = Elongated();
+  for (const double bad : { -1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity() })
+  {
+    auto              filter = c.MakeFilter(bad, 1);
+    const std::string error = edm::test::UpdateAndGetError(filter.GetPointer());
+    EXPECT_NE(error.find("RemeshingEdgeLength"), std::string::npos) << bad << ": " << error;
+  }
+  auto filter = c.MakeFilter(1.0, 1);
+  filter->SetRemeshingInterval(0);
+  EXPECT_NE(edm::test::UpdateAndGetError(filter.GetPointer()).find("RemeshingInterval"), std::string::npos);
+
+  // A mesh with a line cell: refused with remeshing, accepted without.
+  auto mesh = MeshType::New();
+  mesh->SetPoints(const_cast<MeshType::PointsContainer *>(c.sphere->GetPoints()));
+  itk::IdentifierType id = 0;
+  for (auto it = c.sphere->GetCells()->Begin(); it != c.sphere->GetCells()->End(); ++it, ++id)
+  {
+    MeshType::CellAutoPointer cell;
+    it.Value()->MakeCopy(cell);
+    mesh->SetCell(id, cell);
+  }
+  MeshType::CellAutoPointer line;
+  line.TakeOwnership(new itk::LineCell<MeshType::CellType>);
+  line->SetPointId(0, 0);
+  line->SetPointId(1, 1);
+  mesh->SetCell(id, line);
+  filter = c.MakeFilter(1.0, 1);
+  filter->SetInput(mesh);
+  EXPECT_NE(edm::test::UpdateAndGetError(filter.GetPointer()).find("triangle"), std::string::npos);
+  filter->SetRemeshingEdgeLength(0.0);
+  EXPECT_EQ(edm::test::UpdateAndGetError(filter.GetPointer()), "");
+}
+
+TEST(DeformableMeshRenumbering, ARegularSphereSourceIsRenumberedAndGivesTheSameSurface)
+{
+  // itk::RegularSphereMeshSource numbers the points of each subdivision far
+  // from their neighbours: renumbered internally, the output keeps the
+  // input's numbering and matches the run without renumbering up to the
+  // rounding of the sums' order.
+  const ElongatedCase &            c = Elongated();
+  const auto                       sphere = itk::MakeSphereMesh<MeshType>(c.centre, 8.0, 6); // 16 386 points
+  std::vector<FilterType::Pointer> filters;
+  for (const bool renumber : { true, false })
+  {
+    auto filter = c.MakeFilter(0.0, 20);
+    filter->SetInput(sphere);
+    filter->SetRenumberForLocality(renumber);
+    filter->Update();
+    std::ostringstream os;
+    filter->Print(os);
+    EXPECT_NE(os.str().find(renumber ? "Renumbered: true" : "Renumbered: false"), std::string::npos) << os.str();
+    filters.push_back(filter);
+  }
+  const MeshType * a = filters[0]->GetOutput();
+  const MeshType * b = filters[1]->GetOutput();
+  ASSERT_EQ(a->GetNumberOfPoints(), b->GetNumberOfPoints());
+  double largest = 0.0;
+  for (itk::IdentifierType i = 0; i < a->GetNumberOfPoints(); ++i)
+  {
+    largest = std::max(largest, a->GetPoint(i).EuclideanDistanceTo(b->GetPoint(i)));
+  }
+  EXPECT_LT(largest, 1e-9);
+  EXPECT_EQ(a->GetCells(), filters[0]->GetOutput()->GetCells());
+  EXPECT_EQ(a->GetNumberOfCells(), sphere->GetNumberOfCells());
+  // Diagnostics in the input's numbering.
+  const auto & da = filters[0]->GetDisplacementMagnitudes();
+  const auto & db = filters[1]->GetDisplacementMagnitudes();
+  ASSERT_EQ(da.size(), db.size());
+  float diagnosticError = 0.0f;
+  for (std::size_t i = 0; i < da.size(); ++i)
+  {
+    diagnosticError = std::max(diagnosticError, std::abs(da[i] - db[i]));
+  }
+  EXPECT_LT(diagnosticError, 1e-5f);
+
+  // A well-numbered mesh (the flat grid's rows) is left as it is.
+  FlatMesh grid = FlatGrid(100, 1.0);
+  auto     mesh = MeshType::New();
+  for (std::size_t i = 0; i < grid.Points(); ++i)
+  {
+    PointType p;
+    p[0] = grid.x[3 * i] - 2.5;
+    p[1] = grid.x[3 * i + 1] - 2.5;
+    p[2] = 47.5;
+    mesh->SetPoint(i, p);
+  }
+  for (std::size_t t = 0; t < grid.triangles.size() / 3; ++t)
+  {
+    MeshType::CellAutoPointer cell;
+    cell.TakeOwnership(new itk::TriangleCell<MeshType::CellType>);
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      cell->SetPointId(k, grid.triangles[3 * t + k]);
+    }
+    mesh->SetCell(t, cell);
+  }
+  auto filter = c.MakeFilter(0.0, 1);
+  filter->SetInput(mesh);
+  filter->Update();
+  std::ostringstream os;
+  filter->Print(os);
+  EXPECT_NE(os.str().find("Renumbered: false"), std::string::npos);
+}
