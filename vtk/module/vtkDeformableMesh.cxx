@@ -79,6 +79,8 @@ vtkDeformableMesh::vtkDeformableMesh()
   this->Rigidity = filter->GetRigidity();
   this->Balloon = filter->GetBalloon();
   this->MaximumStepLength = filter->GetMaximumStepLength();
+  this->RemeshingEdgeLength = filter->GetRemeshingEdgeLength();
+  this->RemeshingInterval = static_cast<int>(filter->GetRemeshingInterval());
   this->ConvergenceTolerance = filter->GetConvergenceTolerance();
   this->ConvergenceWindow = static_cast<int>(filter->GetConvergenceWindow());
   this->RegionWeight = filter->GetRegionWeight();
@@ -244,6 +246,8 @@ vtkDeformableMesh::PrepareFilter(vtkInformationVector ** inputVector)
   filter->SetRigidity(this->Rigidity);
   filter->SetBalloon(this->Balloon);
   filter->SetMaximumStepLength(this->MaximumStepLength);
+  filter->SetRemeshingEdgeLength(this->RemeshingEdgeLength);
+  filter->SetRemeshingInterval(static_cast<unsigned int>(this->RemeshingInterval));
   filter->SetConvergenceTolerance(this->ConvergenceTolerance);
   filter->SetConvergenceWindow(static_cast<unsigned int>(this->ConvergenceWindow));
   return 1;
@@ -291,6 +295,8 @@ vtkDeformableMesh::PrintSelf(ostream & os, vtkIndent indent)
   os << indent << "RegionSigma: " << this->RegionSigma << "\n";
   os << indent << "IntensityTolerance: " << this->IntensityTolerance << "\n";
   os << indent << "MaximumStepLength: " << this->MaximumStepLength << "\n";
+  os << indent << "RemeshingEdgeLength: " << this->RemeshingEdgeLength << "\n";
+  os << indent << "RemeshingInterval: " << this->RemeshingInterval << "\n";
   os << indent << "ConvergenceTolerance: " << this->ConvergenceTolerance << "\n";
   os << indent << "ConvergenceWindow: " << this->ConvergenceWindow << "\n";
   os << indent << "ComputeDiagnostics: " << (this->ComputeDiagnostics ? "On" : "Off") << "\n";

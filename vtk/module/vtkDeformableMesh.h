@@ -185,6 +185,28 @@ public:
 
   ///@{
   /**
+   * Target edge length of the adaptive remeshing: every RemeshingInterval
+   * iterations the edges are brought into [2/3, 4/3] of it (splits,
+   * collapses, flips, relaxation); the output then has the remeshed points
+   * and triangles and no point or cell data of the input. 0: off.
+   * Millimetres, at least 0; default 0.
+   * Meaning in full: itk::DeformableMeshFilter::SetRemeshingEdgeLength().
+   */
+  vtkSetClampMacro(RemeshingEdgeLength, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(RemeshingEdgeLength, double);
+  ///@}
+
+  ///@{
+  /**
+   * Iterations between two remeshings. At least 1; default 10.
+   * Meaning in full: itk::DeformableMeshFilter::SetRemeshingInterval().
+   */
+  vtkSetClampMacro(RemeshingInterval, int, 1, VTK_INT_MAX);
+  vtkGetMacro(RemeshingInterval, int);
+  ///@}
+
+  ///@{
+  /**
    * Stop when the largest displacement stays below it for ConvergenceWindow
    * iterations; 0: never. Millimetres, at least 0; default 0.
    * Meaning in full: itk::DeformableMeshFilter::SetConvergenceTolerance().
@@ -240,6 +262,8 @@ protected:
   double      Rigidity = 0.0;
   double      Balloon = 0.0;
   double      MaximumStepLength = 0.0;
+  double      RemeshingEdgeLength = 0.0;
+  int         RemeshingInterval = 10;
   double      RegionWeight = 0.0;
   double      RegionSigma = 1.0;
   double      IntensityTolerance = 2.2;

@@ -148,6 +148,29 @@ vtkIterativePolyDataAlgorithm::RequestData(vtkInformation *,
   }
   this->CurrentIteration = static_cast<int>(internals.Filter->GetCurrentIteration());
 
+  // A remeshed surface: the ITK filter's points and triangles, no point or
+  // cell data (they described the input's points and cells).
+  if (internals.Filter->GetTopologyChanged())
+  {
+    try
+    {
+      edm::MeshBridgeOptions options;
+      options.PointData = false;
+      options.CellData = false;
+      vtkSmartPointer<vtkPolyData> remeshed = edm::MeshToPolyData(internals.Filter->GetOutput(), options);
+      output->ShallowCopy(remeshed);
+    }
+    catch (const itk::ExceptionObject & error)
+    {
+      vtkErrorMacro("Converting the remeshed surface failed: " << error.GetDescription());
+      output->Initialize();
+      return 0;
+    }
+    output->GetFieldData()->PassData(input->GetFieldData());
+    this->AddOutputArrays(output);
+    return 1;
+  }
+
   // The input's structure and attributes with the ITK filter's points.
   const auto *    itkPoints = internals.Filter->GetOutput()->GetPoints();
   const vtkIdType numberOfPoints = input->GetNumberOfPoints();

@@ -728,6 +728,8 @@ TEST(VTKIterativeAlgorithms, PrintSelfPrintsEveryParameter)
                              "RegionSigma",
                              "IntensityTolerance",
                              "MaximumStepLength",
+                             "RemeshingEdgeLength",
+                             "RemeshingInterval",
                              "ConvergenceTolerance",
                              "ConvergenceWindow",
                              "ComputeDiagnostics",
@@ -810,4 +812,124 @@ TEST(VTKIterativeAlgorithms, SeriesWriterWritesEveryKthIterationAndACollection)
   EXPECT_EQ(bad->WriteIteration(sphere, 0), 0);
   EXPECT_EQ(bad->WriteCollection(), 0);
   EXPECT_GE(errors.Count(), 4);
+}
+
+// Issue 15 item 2: a remeshing ITK filter's changing mesh passes through the
+// VTK face, step by step, and into a .pvd series.
+namespace
+{
+/** The triangles of a polydata, 3 point ids each. */
+std::vector<vtkIdType>
+Triangles(vtkPolyData * polyData)
+{
+  std::vector<vtkIdType> ids;
+  vtkCellArray *         polys = polyData->GetPolys();
+  polys->InitTraversal();
+  vtkIdType         n = 0;
+  const vtkIdType * cell = nullptr;
+  while (polys->GetNextCell(n, cell))
+  {
+    ids.insert(ids.end(), cell, cell + n);
+    ids.push_back(-n);
+  }
+  return ids;
+}
+std::vector<vtkIdType>
+Triangles(const MeshType * mesh)
+{
+  std::vector<vtkIdType> ids;
+  for (auto it = mesh->GetCells()->Begin(); it != mesh->GetCells()->End(); ++it)
+  {
+    const auto * p = it.Value()->PointIdsBegin();
+    const auto   n = static_cast<vtkIdType>(it.Value()->GetNumberOfPoints());
+    ids.insert(ids.end(), p, p + n);
+    ids.push_back(-n);
+  }
+  return ids;
+}
+} // namespace
+
+TEST(VTKIterativeAlgorithms, DeformableMeshPassesARemeshedSurfaceThrough)
+{
+  const auto                 forces = MakeForces();
+  auto                       forceImage = edm::ImageToImageData(forces.GetPointer(), "Force");
+  vtkNew<vtkTrivialProducer> producer;
+  producer->SetOutput(forceImage);
+  vtkNew<vtkSphereSource> source;
+  source->SetCenter(Center[0], Center[1], Center[2]);
+  source->SetRadius(11.0);
+  source->SetOutputPointsPrecision(vtkAlgorithm::DOUBLE_PRECISION);
+  source->Update();
+  const vtkIdType inputPoints = source->GetOutput()->GetNumberOfPoints();
+
+  vtkNew<CountingDeformableMesh> deformable;
+  deformable->SetInputConnection(0, source->GetOutputPort());
+  deformable->SetForceImageConnection(producer->GetOutputPort());
+  deformable->SetElasticity(0.2);
+  deformable->SetRigidity(0.05);
+  deformable->SetScaleFactor(0.5);
+  deformable->SetRemeshingEdgeLength(1.5);
+  deformable->SetRemeshingInterval(5);
+  deformable->IterateFromZeroOff();
+  for (int n = 1; n <= 12; ++n)
+  {
+    deformable->SetNumberOfIterations(n);
+    deformable->Update();
+    EXPECT_EQ(deformable->TakeSteps(), 1) << "iteration " << n;
+    vtkPolyData * output = deformable->GetOutput();
+    if (n < 5)
+    {
+      EXPECT_EQ(output->GetNumberOfPoints(), inputPoints) << n;
+    }
+    else
+    {
+      EXPECT_GT(output->GetNumberOfPoints(), 4 * inputPoints) << "remeshed to edges of 1.5 mm at " << n;
+      EXPECT_EQ(output->GetNumberOfPolys(), output->GetNumberOfCells()) << "triangles only";
+    }
+    vtkDataArray * diagnostics = output->GetPointData()->GetArray("DisplacementMagnitude");
+    ASSERT_NE(diagnostics, nullptr);
+    EXPECT_EQ(diagnostics->GetNumberOfTuples(), output->GetNumberOfPoints()) << n;
+  }
+  auto filter = itk::DeformableMeshFilter<MeshType, ForceImageType>::New();
+  filter->SetInput(ToITK(source->GetOutput()));
+  filter->SetForceImage(forces);
+  filter->SetElasticity(0.2);
+  filter->SetRigidity(0.05);
+  filter->SetScaleFactor(0.5);
+  filter->SetRemeshingEdgeLength(1.5);
+  filter->SetRemeshingInterval(5);
+  filter->SetNumberOfIterations(12);
+  filter->Update();
+  EXPECT_EQ(Coordinates(deformable->GetOutput()), Coordinates(filter->GetOutput()));
+  EXPECT_EQ(Triangles(deformable->GetOutput()), Triangles(filter->GetOutput()));
+
+  // The series: iterations 0, 5, 10 and 12, each file with its own mesh.
+  const std::string                directory = EDM_TEST_OUTPUT_DIRECTORY;
+  vtkNew<vtkIterationSeriesWriter> writer;
+  writer->SetAlgorithm(deformable);
+  writer->SetFileName((directory + "/remeshed_series.pvd").c_str());
+  writer->SetInterval(5);
+  writer->SetNumberOfIterations(12);
+  ASSERT_EQ(writer->Write(), 1);
+  ASSERT_EQ(writer->GetNumberOfWrittenFiles(), 4);
+  for (int k = 0; k < 4; ++k)
+  {
+    vtkNew<vtkXMLPolyDataReader> reader;
+    reader->SetFileName(writer->GetWrittenFileName(k));
+    reader->Update();
+    vtkPolyData * mesh = reader->GetOutput();
+    if (k == 0)
+    {
+      EXPECT_EQ(mesh->GetNumberOfPoints(), inputPoints);
+    }
+    else
+    {
+      EXPECT_GT(mesh->GetNumberOfPoints(), 4 * inputPoints) << writer->GetWrittenFileName(k);
+    }
+    if (k == 3)
+    {
+      EXPECT_EQ(Coordinates(mesh), Coordinates(filter->GetOutput()));
+      EXPECT_EQ(Triangles(mesh), Triangles(filter->GetOutput()));
+    }
+  }
 }
