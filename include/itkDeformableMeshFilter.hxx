@@ -295,94 +295,122 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology(const std::vector<IndexT
   m_GeneralVertices.clear();
   m_GeneralPairOffsets.assign(1, 0);
   m_GeneralPairs.clear();
-  std::vector<IndexType32>                         ring;
-  std::vector<IndexType32>                         sortedRing;
-  std::vector<IndexType32>                         sortedNeighbours;
-  std::vector<std::pair<IndexType32, IndexType32>> fan;  // pairs sorted by b
-  std::vector<IndexType32>                         ends; // the c of the pairs, sorted
-  for (SizeValueType i = 0; i < numberOfPoints; ++i)
+  // Vertices in blocks over threads (each writes its own neighbours' range);
+  // the vertices outside a single fan are gathered per block and joined in
+  // block order, so the tables do not depend on the number of threads.
+  struct GeneralPart
   {
-    const IndexType32 * vertexPairs = pairs.data() + 2 * static_cast<SizeValueType>(pairOffsets[i]);
-    const IndexType32   numberOfPairs = pairOffsets[i + 1] - pairOffsets[i];
-    const IndexType32   numberOfNeighbours = m_NeighbourOffsets[i + 1] - m_NeighbourOffsets[i];
-    RingKind            kind = GeneralVertex;
-    fan.clear();
-    ends.clear();
-    for (IndexType32 p = 0; p < numberOfPairs; ++p)
+    std::vector<IndexType32> vertices;
+    std::vector<IndexType32> pairs;
+    std::vector<IndexType32> pairCounts;
+  };
+  constexpr SizeValueType  topologyBlock = 16384;
+  const SizeValueType      numberOfTopologyBlocks = (numberOfPoints + topologyBlock - 1) / topologyBlock;
+  std::vector<GeneralPart> parts(numberOfTopologyBlocks);
+  const auto               fanBlock = [&](SizeValueType block) {
+    GeneralPart &                                    part = parts[block];
+    std::vector<IndexType32>                         ring;
+    std::vector<IndexType32>                         sortedRing;
+    std::vector<IndexType32>                         sortedNeighbours;
+    std::vector<std::pair<IndexType32, IndexType32>> fan;  // pairs sorted by b
+    std::vector<IndexType32>                         ends; // the c of the pairs, sorted
+    const SizeValueType                              blockEnd = std::min(numberOfPoints, (block + 1) * topologyBlock);
+    for (SizeValueType i = block * topologyBlock; i < blockEnd; ++i)
     {
-      fan.emplace_back(vertexPairs[2 * p], vertexPairs[2 * p + 1]);
-      ends.push_back(vertexPairs[2 * p + 1]);
-    }
-    std::sort(fan.begin(), fan.end());
-    std::sort(ends.begin(), ends.end());
-    const auto sameFirst = [](const std::pair<IndexType32, IndexType32> & a,
-                              const std::pair<IndexType32, IndexType32> & b) { return a.first == b.first; };
-    // In one fan every neighbour begins at most one pair and ends at most one.
-    const bool oneFanPossible = std::adjacent_find(fan.begin(), fan.end(), sameFirst) == fan.end() &&
-                                std::adjacent_find(ends.begin(), ends.end()) == ends.end();
-    if (numberOfNeighbours == 0)
-    {
-      kind = ClosedRing; // isolated vertex: no umbrella, no normal
-    }
-    else if (numberOfPairs > 0 && oneFanPossible)
-    {
-      // Start at a pair whose b ends no other pair (a boundary fan), if any.
-      IndexType32 start = 0;
-      unsigned    boundaryStarts = 0;
+      const IndexType32 * vertexPairs = pairs.data() + 2 * static_cast<SizeValueType>(pairOffsets[i]);
+      const IndexType32   numberOfPairs = pairOffsets[i + 1] - pairOffsets[i];
+      const IndexType32   numberOfNeighbours = m_NeighbourOffsets[i + 1] - m_NeighbourOffsets[i];
+      RingKind            kind = GeneralVertex;
+      fan.clear();
+      ends.clear();
       for (IndexType32 p = 0; p < numberOfPairs; ++p)
       {
-        if (!std::binary_search(ends.begin(), ends.end(), fan[p].first))
+        fan.emplace_back(vertexPairs[2 * p], vertexPairs[2 * p + 1]);
+        ends.push_back(vertexPairs[2 * p + 1]);
+      }
+      std::sort(fan.begin(), fan.end());
+      std::sort(ends.begin(), ends.end());
+      const auto sameFirst = [](const std::pair<IndexType32, IndexType32> & a,
+                                const std::pair<IndexType32, IndexType32> & b) { return a.first == b.first; };
+      // In one fan every neighbour begins at most one pair and ends at most one.
+      const bool oneFanPossible = std::adjacent_find(fan.begin(), fan.end(), sameFirst) == fan.end() &&
+                                  std::adjacent_find(ends.begin(), ends.end()) == ends.end();
+      if (numberOfNeighbours == 0)
+      {
+        kind = ClosedRing; // isolated vertex: no umbrella, no normal
+      }
+      else if (numberOfPairs > 0 && oneFanPossible)
+      {
+        // Start at a pair whose b ends no other pair (a boundary fan), if any.
+        IndexType32 start = 0;
+        unsigned    boundaryStarts = 0;
+        for (IndexType32 p = 0; p < numberOfPairs; ++p)
         {
-          start = p;
-          ++boundaryStarts;
+          if (!std::binary_search(ends.begin(), ends.end(), fan[p].first))
+          {
+            start = p;
+            ++boundaryStarts;
+          }
+        }
+        // Follow the pairs: c of one is b of the next. With distinct b and c the
+        // walk can only come back to where it started.
+        ring.assign(1, fan[start].first);
+        IndexType32 last = fan[start].second;
+        IndexType32 chained = 1;
+        while (chained < numberOfPairs && last != ring.front())
+        {
+          const auto next = std::lower_bound(fan.begin(),
+                                             fan.end(),
+                                             std::make_pair(last, IndexType32{ 0 }),
+                                             [](const auto & a, const auto & b) { return a.first < b.first; });
+          if (next == fan.end() || next->first != last)
+          {
+            break;
+          }
+          ring.push_back(last);
+          last = next->second;
+          ++chained;
+        }
+        RingKind candidate = ClosedRing;
+        if (last != ring.front())
+        {
+          ring.push_back(last);
+          candidate = OpenRing;
+        }
+        if (chained == numberOfPairs && boundaryStarts <= 1 && (candidate == OpenRing) == (boundaryStarts == 1) &&
+            ring.size() == numberOfNeighbours)
+        {
+          sortedRing = ring;
+          std::sort(sortedRing.begin(), sortedRing.end());
+          sortedNeighbours.assign(m_Neighbours.begin() + m_NeighbourOffsets[i],
+                                  m_Neighbours.begin() + m_NeighbourOffsets[i + 1]);
+          std::sort(sortedNeighbours.begin(), sortedNeighbours.end());
+          if (sortedRing == sortedNeighbours)
+          {
+            kind = candidate;
+            std::copy(ring.begin(), ring.end(), m_Neighbours.begin() + m_NeighbourOffsets[i]);
+          }
         }
       }
-      // Follow the pairs: c of one is b of the next. With distinct b and c the
-      // walk can only come back to where it started.
-      ring.assign(1, fan[start].first);
-      IndexType32 last = fan[start].second;
-      IndexType32 chained = 1;
-      while (chained < numberOfPairs && last != ring.front())
+      m_RingKinds[i] = kind;
+      if (kind == GeneralVertex)
       {
-        const auto next = std::lower_bound(fan.begin(),
-                                           fan.end(),
-                                           std::make_pair(last, IndexType32{ 0 }),
-                                           [](const auto & a, const auto & b) { return a.first < b.first; });
-        if (next == fan.end() || next->first != last)
-        {
-          break;
-        }
-        ring.push_back(last);
-        last = next->second;
-        ++chained;
-      }
-      RingKind candidate = ClosedRing;
-      if (last != ring.front())
-      {
-        ring.push_back(last);
-        candidate = OpenRing;
-      }
-      if (chained == numberOfPairs && boundaryStarts <= 1 && (candidate == OpenRing) == (boundaryStarts == 1) &&
-          ring.size() == numberOfNeighbours)
-      {
-        sortedRing = ring;
-        std::sort(sortedRing.begin(), sortedRing.end());
-        sortedNeighbours.assign(m_Neighbours.begin() + m_NeighbourOffsets[i],
-                                m_Neighbours.begin() + m_NeighbourOffsets[i + 1]);
-        std::sort(sortedNeighbours.begin(), sortedNeighbours.end());
-        if (sortedRing == sortedNeighbours)
-        {
-          kind = candidate;
-          std::copy(ring.begin(), ring.end(), m_Neighbours.begin() + m_NeighbourOffsets[i]);
-        }
+        part.vertices.push_back(static_cast<IndexType32>(i));
+        part.pairs.insert(part.pairs.end(), vertexPairs, vertexPairs + 2 * numberOfPairs);
+        part.pairCounts.push_back(numberOfPairs);
       }
     }
-    m_RingKinds[i] = kind;
-    if (kind == GeneralVertex)
+  };
+  MultiThreaderBase * topologyThreader = this->GetMultiThreader();
+  topologyThreader->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
+  topologyThreader->ParallelizeArray(0, numberOfTopologyBlocks, fanBlock, nullptr);
+  for (const GeneralPart & part : parts)
+  {
+    m_GeneralVertices.insert(m_GeneralVertices.end(), part.vertices.begin(), part.vertices.end());
+    m_GeneralPairs.insert(m_GeneralPairs.end(), part.pairs.begin(), part.pairs.end());
+    for (const IndexType32 count : part.pairCounts)
     {
-      m_GeneralVertices.push_back(static_cast<IndexType32>(i));
-      m_GeneralPairs.insert(m_GeneralPairs.end(), vertexPairs, vertexPairs + 2 * numberOfPairs);
-      m_GeneralPairOffsets.push_back(static_cast<IndexType32>(m_GeneralPairs.size() / 2));
+      m_GeneralPairOffsets.push_back(m_GeneralPairOffsets.back() + count);
     }
   }
 
@@ -808,6 +836,7 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
   const SizeValueType   numberOfPoints = this->GetNumberOfCachedPoints();
   x.resize(3 * numberOfPoints); // the guard value goes
   m_Remesher.SetTargetEdgeLength(m_RemeshingEdgeLength);
+  m_Remesher.SetMultiThreader(this->GetMultiThreader(), this->GetNumberOfWorkUnits());
   m_Remesher.Remesh(x, numberOfPoints, m_Triangles);
   const std::vector<IndexType32> & parents = m_Remesher.Parents();
   const SizeValueType              newNumberOfPoints = parents.size();

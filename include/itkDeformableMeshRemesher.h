@@ -19,8 +19,10 @@
 #define itkDeformableMeshRemesher_h
 
 #include "itkMacro.h"
+#include "itkMultiThreaderBase.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -126,6 +128,17 @@ public:
     return m_MaximumRatio * m_TargetEdgeLength;
   }
 
+  /** Threads for the passes that run in parallel (building the corner
+   * table, the manifold check, the relaxation): \a threader with
+   * \a workUnits work units, or none (nullptr, the default: serial). The
+   * result does not depend on it. */
+  void
+  SetMultiThreader(MultiThreaderBase * threader, unsigned int workUnits)
+  {
+    m_Threader = threader;
+    m_WorkUnits = workUnits;
+  }
+
   /** Number of tangential relaxation sweeps per Remesh(). Default: 1. */
   void
   SetRelaxationSweeps(unsigned int sweeps)
@@ -224,14 +237,20 @@ private:
   void
   LengthenPass();
   bool
-  MoveKeepsBand(IndexType v, const double * q, IndexType other) const;
+  MoveKeepsBand(IndexType v, const double * q, IndexType other);
+  /** Runs body(begin, end) over [0, n) in blocks, on the threader if any. */
+  template <typename TBody>
+  void
+  ParallelFor(std::size_t n, TBody && body) const;
   void
   Compact(std::vector<double> & coordinates, std::vector<IndexType> & triangles);
 
-  double       m_TargetEdgeLength{ 1.0 };
-  double       m_MinimumRatio{ 0.8 };
-  double       m_MaximumRatio{ 4.0 / 3.0 };
-  unsigned int m_RelaxationSweeps{ 1 };
+  MultiThreaderBase * m_Threader{ nullptr };
+  unsigned int        m_WorkUnits{ 1 };
+  double              m_TargetEdgeLength{ 1.0 };
+  double              m_MinimumRatio{ 0.8 };
+  double              m_MaximumRatio{ 4.0 / 3.0 };
+  unsigned int        m_RelaxationSweeps{ 1 };
 
   // Corner table: corner c = 3 t + k is vertex m_V[c] of triangle t; the
   // half-edge of corner c goes from m_V[c] to m_V[Next(c)]; m_O[c] is the
@@ -306,6 +325,28 @@ DeformableMeshRemesher::NewVertex(const double * p, IndexType parent)
   return v;
 }
 
+template <typename TBody>
+void
+DeformableMeshRemesher::ParallelFor(std::size_t n, TBody && body) const
+{
+  constexpr std::size_t blockSize = 8192;
+  const std::size_t     blocks = (n + blockSize - 1) / blockSize;
+  if (m_Threader == nullptr || blocks < 2)
+  {
+    body(std::size_t{ 0 }, n);
+    return;
+  }
+  m_Threader->SetNumberOfWorkUnits(std::max(1u, m_WorkUnits));
+  m_Threader->ParallelizeArray(
+    0,
+    blocks,
+    [&](SizeValueType block) {
+      const std::size_t begin = block * blockSize;
+      body(begin, std::min(n, begin + blockSize));
+    },
+    nullptr);
+}
+
 inline void
 DeformableMeshRemesher::Build(std::size_t numberOfPoints)
 {
@@ -329,41 +370,43 @@ DeformableMeshRemesher::Build(std::size_t numberOfPoints)
     }
   }
   m_O.assign(numberOfCorners, Boundary);
-  for (std::size_t c = 0; c < numberOfCorners; ++c)
-  {
-    const IndexType a = m_V[c];
-    const IndexType b = m_V[Next(static_cast<IndexType>(c))];
-    unsigned        same = 0;
-    unsigned        opposite = 0;
-    IndexType       twin = Invalid;
-    if (a == b)
+  this->ParallelFor(numberOfCorners, [&](std::size_t first, std::size_t last) {
+    for (std::size_t c = first; c < last; ++c)
     {
-      m_O[c] = NonManifold;
-      continue;
-    }
-    for (IndexType k = offsets[a]; k < offsets[a + 1]; ++k)
-    {
-      const IndexType d = corners[k];
-      same += m_V[Next(d)] == b;
-      opposite += m_V[Prev(d)] == b; // half-edge b -> a ends at a
-      if (m_V[Prev(d)] == b)
+      const IndexType a = m_V[c];
+      const IndexType b = m_V[Next(static_cast<IndexType>(c))];
+      unsigned        same = 0;
+      unsigned        opposite = 0;
+      IndexType       twin = Invalid;
+      if (a == b)
       {
-        twin = Prev(d);
+        m_O[c] = NonManifold;
+        continue;
+      }
+      for (IndexType k = offsets[a]; k < offsets[a + 1]; ++k)
+      {
+        const IndexType d = corners[k];
+        same += m_V[Next(d)] == b;
+        opposite += m_V[Prev(d)] == b; // half-edge b -> a ends at a
+        if (m_V[Prev(d)] == b)
+        {
+          twin = Prev(d);
+        }
+      }
+      if (same == 1 && opposite == 1)
+      {
+        m_O[c] = twin;
+      }
+      else if (same == 1 && opposite == 0)
+      {
+        m_O[c] = Boundary;
+      }
+      else
+      {
+        m_O[c] = NonManifold;
       }
     }
-    if (same == 1 && opposite == 1)
-    {
-      m_O[c] = twin;
-    }
-    else if (same == 1 && opposite == 0)
-    {
-      m_O[c] = Boundary;
-    }
-    else
-    {
-      m_O[c] = NonManifold;
-    }
-  }
+  });
   m_VertexCorner.assign(numberOfPoints, Invalid);
   m_State.assign(numberOfPoints, RemesherFree);
   m_Valence.assign(numberOfPoints, 0);
@@ -399,17 +442,21 @@ DeformableMeshRemesher::Build(std::size_t numberOfPoints)
     }
   }
   // A vertex whose corners do not form one fan is non-manifold: frozen.
-  for (std::size_t i = 0; i < numberOfPoints; ++i)
-  {
-    if (m_State[i] == RemesherFree || m_State[i] == RemesherBoundary)
+  // (Ring() reads only the state of the vertex it walks around.)
+  this->ParallelFor(numberOfPoints, [&](std::size_t first, std::size_t last) {
+    std::vector<IndexType> ring;
+    std::vector<IndexType> fan;
+    for (std::size_t i = first; i < last; ++i)
     {
-      if (!this->Ring(static_cast<IndexType>(i), m_RingA, &m_CornersA) ||
-          m_CornersA.size() != offsets[i + 1] - offsets[i])
+      if (m_State[i] == RemesherFree || m_State[i] == RemesherBoundary)
       {
-        m_State[i] = RemesherFrozen;
+        if (!this->Ring(static_cast<IndexType>(i), ring, &fan) || fan.size() != offsets[i + 1] - offsets[i])
+        {
+          m_State[i] = RemesherFrozen;
+        }
       }
     }
-  }
+  });
   // Start the ring walk of a boundary vertex anywhere: Ring() finds the end.
 }
 
@@ -917,81 +964,89 @@ DeformableMeshRemesher::FlipPass()
 inline void
 DeformableMeshRemesher::Relax()
 {
-  const std::size_t   numberOfPoints = m_State.size();
-  std::vector<double> moved(m_X);
-  for (std::size_t i = 0; i < numberOfPoints; ++i)
-  {
-    if (m_State[i] != RemesherFree || !this->Ring(static_cast<IndexType>(i), m_RingA, &m_CornersA))
+  const std::size_t        numberOfPoints = m_State.size();
+  std::vector<double>      moved(m_X);
+  std::atomic<std::size_t> relaxed{ 0 };
+  this->ParallelFor(numberOfPoints, [&](std::size_t first, std::size_t last) {
+    std::vector<IndexType> m_RingA; // per block
+    std::vector<IndexType> m_CornersA;
+    std::size_t            count = 0;
+    for (std::size_t i = first; i < last; ++i)
     {
-      continue;
-    }
-    const double * p = m_X.data() + 3 * i;
-    double         centroid[3] = { 0.0, 0.0, 0.0 };
-    double         normal[3] = { 0.0, 0.0, 0.0 };
-    for (const IndexType w : m_RingA)
-    {
+      if (m_State[i] != RemesherFree || !this->Ring(static_cast<IndexType>(i), m_RingA, &m_CornersA))
+      {
+        continue;
+      }
+      const double * p = m_X.data() + 3 * i;
+      double         centroid[3] = { 0.0, 0.0, 0.0 };
+      double         normal[3] = { 0.0, 0.0, 0.0 };
+      for (const IndexType w : m_RingA)
+      {
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          centroid[d] += m_X[3 * static_cast<std::size_t>(w) + d];
+        }
+      }
+      for (const IndexType k : m_CornersA)
+      {
+        double n[3];
+        this->TriangleNormal(m_V[k], m_V[Next(k)], m_V[Prev(k)], n);
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          normal[d] += n[d];
+        }
+      }
+      const double length = std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+      if (!(length > 0.0))
+      {
+        continue;
+      }
+      double step[3];
+      double along = 0.0;
       for (unsigned int d = 0; d < 3; ++d)
       {
-        centroid[d] += m_X[3 * static_cast<std::size_t>(w) + d];
+        normal[d] /= length;
+        step[d] = centroid[d] / static_cast<double>(m_RingA.size()) - p[d];
+        along += step[d] * normal[d];
       }
-    }
-    for (const IndexType k : m_CornersA)
-    {
-      double n[3];
-      this->TriangleNormal(m_V[k], m_V[Next(k)], m_V[Prev(k)], n);
+      double q[3];
       for (unsigned int d = 0; d < 3; ++d)
       {
-        normal[d] += n[d];
+        q[d] = p[d] + 0.5 * (step[d] - along * normal[d]);
       }
-    }
-    const double length = std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
-    if (!(length > 0.0))
-    {
-      continue;
-    }
-    double step[3];
-    double along = 0.0;
-    for (unsigned int d = 0; d < 3; ++d)
-    {
-      normal[d] /= length;
-      step[d] = centroid[d] / static_cast<double>(m_RingA.size()) - p[d];
-      along += step[d] * normal[d];
-    }
-    double q[3];
-    for (unsigned int d = 0; d < 3; ++d)
-    {
-      q[d] = p[d] + 0.5 * (step[d] - along * normal[d]);
-    }
-    // Refuse a move that turns one of the vertex's triangles around.
-    bool keeps = true;
-    for (const IndexType k : m_CornersA)
-    {
-      const double * q1 = m_X.data() + 3 * static_cast<std::size_t>(m_V[Next(k)]);
-      const double * q2 = m_X.data() + 3 * static_cast<std::size_t>(m_V[Prev(k)]);
-      double         before[3];
-      double         after[3];
-      this->TriangleNormal(p, q1, q2, before);
-      this->TriangleNormal(q, q1, q2, after);
-      if (!(before[0] * after[0] + before[1] * after[1] + before[2] * after[2] > 0.0))
+      // Refuse a move that turns one of the vertex's triangles around.
+      bool keeps = true;
+      for (const IndexType k : m_CornersA)
       {
-        keeps = false;
-        break;
+        const double * q1 = m_X.data() + 3 * static_cast<std::size_t>(m_V[Next(k)]);
+        const double * q2 = m_X.data() + 3 * static_cast<std::size_t>(m_V[Prev(k)]);
+        double         before[3];
+        double         after[3];
+        this->TriangleNormal(p, q1, q2, before);
+        this->TriangleNormal(q, q1, q2, after);
+        if (!(before[0] * after[0] + before[1] * after[1] + before[2] * after[2] > 0.0))
+        {
+          keeps = false;
+          break;
+        }
+      }
+      if (keeps)
+      {
+        std::copy(q, q + 3, moved.data() + 3 * i);
+        ++count;
       }
     }
-    if (keeps)
-    {
-      std::copy(q, q + 3, moved.data() + 3 * i);
-      ++m_Statistics.relaxed;
-    }
-  }
+    relaxed += count;
+  });
+  m_Statistics.relaxed += relaxed;
   m_X.swap(moved);
 }
 
 inline bool
-DeformableMeshRemesher::MoveKeepsBand(IndexType v, const double * q, IndexType other) const
+DeformableMeshRemesher::MoveKeepsBand(IndexType v, const double * q, IndexType other)
 {
-  std::vector<IndexType> ring;
-  std::vector<IndexType> corners;
+  std::vector<IndexType> & ring = m_RingB;
+  std::vector<IndexType> & corners = m_CornersB;
   if (m_State[v] != RemesherFree || !this->Ring(v, ring, &corners))
   {
     return false;
@@ -1041,11 +1096,12 @@ DeformableMeshRemesher::LengthenPass()
     }
     const IndexType a = m_V[c];
     const IndexType b = m_V[Next(c)];
-    const double    length = std::sqrt(this->Length2(a, b));
-    if (!(length < minimum) || !(length > 0.0))
+    const double    length2 = this->Length2(a, b);
+    if (!(length2 < m_Min2) || !(length2 > 0.0))
     {
       continue;
     }
+    const double length = std::sqrt(length2);
     double *     pa = m_X.data() + 3 * static_cast<std::size_t>(a);
     double *     pb = m_X.data() + 3 * static_cast<std::size_t>(b);
     const double u[3] = { (pb[0] - pa[0]) / length, (pb[1] - pa[1]) / length, (pb[2] - pa[2]) / length };
@@ -1149,12 +1205,14 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
 {
   if (!(m_TargetEdgeLength > 0.0 && std::isfinite(m_TargetEdgeLength)))
   {
-    itkGenericExceptionMacro("DeformableMeshRemesher: the target edge length must be finite and positive; it is "
+    itkGenericExceptionMacro("DeformableMeshRemesher: the target edge length "
+                             "must be finite and positive; it is "
                              << m_TargetEdgeLength << ".");
   }
   if (!(m_MinimumRatio > 0.0 && m_MinimumRatio < m_MaximumRatio && std::isfinite(m_MaximumRatio)))
   {
-    itkGenericExceptionMacro("DeformableMeshRemesher: the edge length ratios must satisfy 0 < minimum < maximum; they "
+    itkGenericExceptionMacro("DeformableMeshRemesher: the edge length ratios "
+                             "must satisfy 0 < minimum < maximum; they "
                              "are "
                              << m_MinimumRatio << " and " << m_MaximumRatio << ".");
   }
