@@ -28,6 +28,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <utility>
 
 namespace itk
@@ -87,6 +88,10 @@ DeformableMeshFilter<TMesh, TForceImage>::VerifyPreconditions() const
   if (m_RemeshingInterval == 0)
   {
     itkExceptionMacro("RemeshingInterval must be at least 1 iteration; it is 0.");
+  }
+  if (!(m_MinimumDistance >= 0.0 && std::isfinite(m_MinimumDistance)))
+  {
+    itkExceptionMacro("MinimumDistance must be finite and non-negative; it is " << m_MinimumDistance << ".");
   }
   this->VerifyImageTermParameters();
 }
@@ -511,6 +516,103 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
   {
     this->EstimateImageTermModel();
   }
+  this->ResetCollision();
+}
+
+template <typename TMesh, typename TForceImage>
+void
+DeformableMeshFilter<TMesh, TForceImage>::ResetCollision(const std::vector<uint32_t> * triangles)
+{
+  m_NumberOfCollisionsPrevented = 0;
+  m_TotalNumberOfCollisionsPrevented = 0;
+  m_NumberOfConstrainedVertices = 0;
+  if (!m_PreventSelfIntersections)
+  {
+    m_Collision.Clear();
+    return;
+  }
+  std::vector<uint32_t>      extracted;
+  std::vector<SizeValueType> cells;
+  if (triangles == nullptr)
+  {
+    SurfaceCollision::ExtractTriangles(this->GetInput(), extracted, &cells);
+    triangles = &extracted;
+  }
+  const SizeValueType                     numberOfTriangles = triangles->size() / 3;
+  std::pair<SizeValueType, SizeValueType> first;
+  const SizeValueType                     count = SurfaceCollision::CountSelfIntersections(
+    this->GetCoordinates().data(), triangles->data(), numberOfTriangles, &first);
+  if (count > 0)
+  {
+    m_Collision.Clear();
+    std::ostringstream cellText;
+    if (!cells.empty())
+    {
+      cellText << " (cells " << cells[first.first] << " and " << cells[first.second] << ")";
+    }
+    itkExceptionMacro("PreventSelfIntersections is on and the mesh intersects itself: "
+                      << count << " pair(s) of triangles sharing no vertex intersect, the first triangles "
+                      << first.first << " and " << first.second << cellText.str()
+                      << ". Repair the input mesh or turn PreventSelfIntersections off.");
+  }
+  m_Collision.SetSurface(this->GetNumberOfCachedPoints(), triangles->data(), numberOfTriangles);
+}
+
+template <typename TMesh, typename TForceImage>
+void
+DeformableMeshFilter<TMesh, TForceImage>::ConstrainSelfIntersections(std::vector<double> & blockMaximum, bool diagnose)
+{
+  using DeformableMeshFilterDetail::BlockSize;
+  if (!m_Collision.HasSurface())
+  {
+    // Turned on after the last reset: set up (and check) now.
+    const SizeValueType total = m_TotalNumberOfCollisionsPrevented;
+    this->ResetCollision();
+    m_TotalNumberOfCollisionsPrevented = total;
+  }
+  const std::vector<double> & coordinates = this->GetCoordinates();
+  const auto                  result = m_Collision.Constrain(coordinates.data(),
+                                            m_NextCoordinates.data(),
+                                            m_MinimumDistance,
+                                            this->GetMultiThreader(),
+                                            this->GetNumberOfWorkUnits());
+  m_NumberOfCollisionsPrevented = result.violations;
+  m_TotalNumberOfCollisionsPrevented += result.violations;
+  m_NumberOfConstrainedVertices = result.constrained;
+  if (result.constrained == 0)
+  {
+    return;
+  }
+  // The displacements of the constrained vertices changed: their
+  // diagnostics, and the largest displacement of their blocks.
+  const SizeValueType  numberOfPoints = this->GetNumberOfCachedPoints();
+  std::vector<uint8_t> blocks(blockMaximum.size(), 0);
+  const auto           length = [&](SizeValueType i) {
+    const double dx = m_NextCoordinates[3 * i] - coordinates[3 * i];
+    const double dy = m_NextCoordinates[3 * i + 1] - coordinates[3 * i + 1];
+    const double dz = m_NextCoordinates[3 * i + 2] - coordinates[3 * i + 2];
+    return std::sqrt(dx * dx + dy * dy + dz * dz);
+  };
+  for (const auto i : m_Collision.GetConstrainedPoints())
+  {
+    blocks[i / BlockSize] = 1;
+    if (diagnose)
+    {
+      m_DisplacementMagnitudes[i] = static_cast<float>(length(i));
+    }
+  }
+  for (SizeValueType block = 0; block < blocks.size(); ++block)
+  {
+    if (blocks[block])
+    {
+      double largest = 0.0;
+      for (SizeValueType i = block * BlockSize; i < std::min(numberOfPoints, (block + 1) * BlockSize); ++i)
+      {
+        largest = std::max(largest, length(i));
+      }
+      blockMaximum[block] = largest;
+    }
+  }
 }
 
 template <typename TMesh, typename TForceImage>
@@ -729,6 +831,10 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
     }
   }
 
+  if (m_PreventSelfIntersections)
+  {
+    this->ConstrainSelfIntersections(blockMaximum, diagnose);
+  }
   coordinates.swap(m_NextCoordinates);
 
   m_LastMaximumDisplacement = *std::max_element(blockMaximum.begin(), blockMaximum.end());
@@ -903,6 +1009,11 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "MaximumStepLength: " << m_MaximumStepLength << std::endl;
   os << indent << "ConvergenceTolerance: " << m_ConvergenceTolerance << std::endl;
   os << indent << "ConvergenceWindow: " << m_ConvergenceWindow << std::endl;
+  os << indent << "PreventSelfIntersections: " << (m_PreventSelfIntersections ? "On" : "Off") << std::endl;
+  os << indent << "MinimumDistance: " << m_MinimumDistance << std::endl;
+  os << indent << "NumberOfCollisionsPrevented: " << m_NumberOfCollisionsPrevented << " (total "
+     << m_TotalNumberOfCollisionsPrevented << "), constrained vertices: " << m_NumberOfConstrainedVertices
+     << ", collision index rebuilds: " << m_Collision.GetNumberOfRebuilds() << std::endl;
   os << indent << "Converged: " << (m_Converged ? "true" : "false") << std::endl;
   os << indent << "QuietIterations: " << m_QuietIterations << std::endl;
   os << indent << "LastMaximumDisplacement: " << m_LastMaximumDisplacement << std::endl;
