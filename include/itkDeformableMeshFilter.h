@@ -553,12 +553,15 @@ private:
   }
 
   /** Sets up the collision test (PreventSelfIntersections) for the current
-   * mesh and checks the current coordinates: at reset, and after any change
-   * of the mesh (remeshing), with the current triangles (3 point indices
-   * each; null: the input mesh's triangles and fan-triangulated polygons).
-   * Resets the collision counts. Throws when the mesh intersects itself. */
+   * mesh. \a triangles: the current triangles, 3 point indices each over the
+   * cached points, in the cache's numbering; null (at reset, without
+   * renumbering): the input mesh's triangles and fan-triangulated polygons.
+   * They are kept (also with prevention off) for a later switch on. With
+   * \a check (at reset): the cached coordinates are checked (throws, naming
+   * the first intersecting pair, when they intersect themselves) and the
+   * total count is reset; without (after a remeshing) the total is kept. */
   void
-  ResetCollision(const std::vector<uint32_t> * triangles = nullptr);
+  ResetCollision(const std::vector<uint32_t> * triangles = nullptr, bool check = true);
 
   /** The collision hook of Iterate(): constrains m_NextCoordinates; keeps
    * the diagnostics and the blocks' largest displacements right. */
@@ -633,6 +636,8 @@ private:
   SizeValueType m_NumberOfConstrainedVertices{ 0 };
   /** The collision test's tables and index (PreventSelfIntersections). */
   SurfaceCollision m_Collision;
+  /** The triangles last given to ResetCollision() (empty: the input's). */
+  std::vector<uint32_t> m_CollisionTriangles;
   /** Finite values and step bound of the force image (bad input). */
   ForceImageCheck<ForceImageType> m_ForceImageCheck;
 

@@ -521,11 +521,22 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
 
 template <typename TMesh, typename TForceImage>
 void
-DeformableMeshFilter<TMesh, TForceImage>::ResetCollision(const std::vector<uint32_t> * triangles)
+DeformableMeshFilter<TMesh, TForceImage>::ResetCollision(const std::vector<uint32_t> * triangles, bool check)
 {
   m_NumberOfCollisionsPrevented = 0;
-  m_TotalNumberOfCollisionsPrevented = 0;
   m_NumberOfConstrainedVertices = 0;
+  if (check)
+  {
+    m_TotalNumberOfCollisionsPrevented = 0;
+  }
+  if (triangles == nullptr)
+  {
+    m_CollisionTriangles.clear();
+  }
+  else if (triangles != &m_CollisionTriangles)
+  {
+    m_CollisionTriangles = *triangles;
+  }
   if (!m_PreventSelfIntersections)
   {
     m_Collision.Clear();
@@ -538,7 +549,12 @@ DeformableMeshFilter<TMesh, TForceImage>::ResetCollision(const std::vector<uint3
     SurfaceCollision::ExtractTriangles(this->GetInput(), extracted, &cells);
     triangles = &extracted;
   }
-  const SizeValueType                     numberOfTriangles = triangles->size() / 3;
+  const SizeValueType numberOfTriangles = triangles->size() / 3;
+  m_Collision.SetSurface(this->GetNumberOfCachedPoints(), triangles->data(), numberOfTriangles);
+  if (!check)
+  {
+    return;
+  }
   std::pair<SizeValueType, SizeValueType> first;
   const SizeValueType                     count = SurfaceCollision::CountSelfIntersections(
     this->GetCoordinates().data(), triangles->data(), numberOfTriangles, &first);
@@ -555,7 +571,6 @@ DeformableMeshFilter<TMesh, TForceImage>::ResetCollision(const std::vector<uint3
                       << first.first << " and " << first.second << cellText.str()
                       << ". Repair the input mesh or turn PreventSelfIntersections off.");
   }
-  m_Collision.SetSurface(this->GetNumberOfCachedPoints(), triangles->data(), numberOfTriangles);
 }
 
 template <typename TMesh, typename TForceImage>
@@ -566,9 +581,7 @@ DeformableMeshFilter<TMesh, TForceImage>::ConstrainSelfIntersections(std::vector
   if (!m_Collision.HasSurface())
   {
     // Turned on after the last reset: set up (and check) now.
-    const SizeValueType total = m_TotalNumberOfCollisionsPrevented;
-    this->ResetCollision();
-    m_TotalNumberOfCollisionsPrevented = total;
+    this->ResetCollision(m_CollisionTriangles.empty() ? nullptr : &m_CollisionTriangles, true);
   }
   const std::vector<double> & coordinates = this->GetCoordinates();
   const auto                  result = m_Collision.Constrain(coordinates.data(),

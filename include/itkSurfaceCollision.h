@@ -638,15 +638,15 @@ StoreBox(const double * lower, const double * upper, double margin, float * box)
  *
  * Constrain() takes the current positions x (a state in which no pair
  * intersects) and the proposed next positions y, and modifies y. A pair
- * (A, B) violates the constraint at y when the triangles intersect, or when
- * their distance is below the minimum distance d and below their distance
- * at x (a pair that was already closer than d may stay so but not come
- * closer). The vertices of violating pairs get their displacements halved,
+ * (A, B) violates the constraint at y when their distance is below the
+ * minimum distance d and below their distance at x: a pair that was already
+ * closer than d may stay so but not come closer, and from a state without
+ * intersection (distance 0) none is created. The vertices of violating pairs get their displacements halved,
  * at the next violation halved again, at the third set to zero; the pairs of
  * every modified triangle are tested again until none violates. This
  * terminates (at worst every displacement is zero, which gives back x) and
- * the result is a state in which no pair intersects and no pair that was at
- * least d apart is closer than d.
+ * the result is a state in which no pair that did not intersect at x
+ * intersects, and no pair that was at least d apart is closer than d.
  *
  * The spatial index: each point i has a reference position r_i and a skin
  * s_i; a triangle's box is the box of the balls of radius s_i around its
@@ -1106,10 +1106,6 @@ private:
     if (next >= d)
     {
       return false;
-    }
-    if (next <= 0.0)
-    {
-      return true;
     }
     const double * a0[3] = { x + 3 * vt[0], x + 3 * vt[1], x + 3 * vt[2] };
     const double * b0[3] = { x + 3 * vu[0], x + 3 * vu[1], x + 3 * vu[2] };
