@@ -483,23 +483,34 @@ public:
         }
       }
     };
+    // A box whose cells hash alike is entered once in their bucket: its
+    // entries in one bucket would be consecutive.
+    std::vector<uint32_t> last(buckets, std::numeric_limits<uint32_t>::max());
     for (SizeValueType t = 0; t < numberOfBoxes; ++t)
     {
-      forEachCell(boxes + 6 * t, [this](SizeValueType bucket) { ++m_BucketOffsets[bucket + 1]; });
+      forEachCell(boxes + 6 * t, [&](SizeValueType bucket) {
+        if (last[bucket] != t)
+        {
+          last[bucket] = static_cast<uint32_t>(t);
+          ++m_BucketOffsets[bucket + 1];
+        }
+      });
     }
+    std::fill(last.begin(), last.end(), std::numeric_limits<uint32_t>::max());
     for (SizeValueType b = 0; b < buckets; ++b)
     {
       m_BucketOffsets[b + 1] += m_BucketOffsets[b];
     }
-    m_Entries.resize(entries);
+    m_Entries.resize(m_BucketOffsets[buckets]);
     std::vector<SizeValueType> fill(m_BucketOffsets.begin(), m_BucketOffsets.end() - 1);
     for (SizeValueType t = 0; t < numberOfBoxes; ++t)
     {
       forEachCell(boxes + 6 * t, [&](SizeValueType bucket) {
-        const SizeValueType slot = fill[bucket]++;
-        // A box entered twice in one bucket (two of its cells hash alike)
-        // is visited once per cell; ForEachOverlap() keeps one visit.
-        m_Entries[slot] = static_cast<uint32_t>(t);
+        if (last[bucket] != t)
+        {
+          last[bucket] = static_cast<uint32_t>(t);
+          m_Entries[fill[bucket]++] = static_cast<uint32_t>(t);
+        }
       });
     }
   }
@@ -534,12 +545,11 @@ public:
               continue;
             }
             // Visit the pair in one cell only: the one that holds the lower
-            // corner of the boxes' intersection (a duplicate entry of u in
-            // this bucket is skipped the same way: only its first copy).
+            // corner of the boxes' intersection.
             const int64_t ci = this->CellOf(std::max(a[0], b[0]), 0);
             const int64_t cj = this->CellOf(std::max(a[1], b[1]), 1);
             const int64_t ck = this->CellOf(std::max(a[2], b[2]), 2);
-            if (ci != i || cj != j || ck != k || std::find(begin, e, *e) != e)
+            if (ci != i || cj != j || ck != k)
             {
               continue;
             }
@@ -569,7 +579,9 @@ private:
   int64_t
   CellOf(double x, unsigned int axis) const
   {
-    return static_cast<int64_t>(std::floor((x - m_Origin[axis]) * m_InverseCellSize));
+    // Every box lies above the origin (the lowest corner): truncation is
+    // the floor.
+    return static_cast<int64_t>((x - m_Origin[axis]) * m_InverseCellSize);
   }
 
   void
@@ -648,21 +660,23 @@ StoreBox(const double * lower, const double * upper, double margin, float * box)
  * the result is a state in which no pair that did not intersect at x
  * intersects, and no pair that was at least d apart is closer than d.
  *
- * The spatial index: each point i has a reference position r_i and a skin
- * s_i; a triangle's box is the box of the balls of radius s_i around its
- * reference positions, widened by d/2, and the boxes are entered in a
- * uniform hashed grid. Two triangles whose boxes do not overlap are more
- * than d apart as long as every point stays within its skin. Each triangle
- * also keeps a clearance: a lower bound of its distance to the triangles
- * near it at the reference positions, less d. At each Constrain() the
- * motion m_i = max(|x_i - r_i|, |y_i - r_i|) of every point is computed;
- * where some m_i exceeds s_i, the index is rebuilt at x (skin: a quarter of
- * the mean edge length, or 1.5 times the point's proposed displacement if
- * larger). Only the triangles whose motion m_T (largest of their points')
- * plus the largest motion M of all points reaches their clearance are
- * tested, against the triangles of the grid near them: on a surface that
- * has settled, a step costs two passes over the points and one over the
- * triangles.
+ * The spatial index: each point i has a reference position r_i (x at the
+ * last rebuild) and a box it may move in: the box swept by its displacement
+ * y_i - x_i of that step and two more of the same, widened by a quarter of
+ * the mean edge length. A triangle's box is the union of its points' boxes,
+ * widened by d/2; the boxes are entered in a uniform hashed grid. Two
+ * triangles whose boxes do not overlap are more than d apart as long as
+ * every point stays in its box. Each triangle also keeps a clearance: a
+ * lower bound of its distance at the reference positions to the triangles
+ * whose boxes overlap its own, less d (bounding spheres; the exact distance
+ * where the spheres are close). At each Constrain() the motion
+ * m_i = max(|x_i - r_i|, |y_i - r_i|) of every point is computed; where some
+ * y_i leaves its box, the index is rebuilt at x. Only the triangles whose
+ * motion m_T (largest of their points') plus the largest motion M of all
+ * points reaches their clearance are tested, against the triangles of the
+ * grid near them: on a surface that has settled, a step costs a pass over
+ * the points and one over the triangles; a surface that moves fast rebuilds
+ * the index every two or three steps.
  *
  * CountSelfIntersections() counts the intersecting pairs of a surface with
  * the same grid (exact triangle boxes).
@@ -811,12 +825,13 @@ public:
       }
     };
 
-    // Motion of every point since the reference positions; an escape from
-    // the skin makes the index be rebuilt.
+    // Motion of every point since the reference positions; a point out of
+    // its box makes the index be rebuilt.
     float largest = 0.0f;
     if (m_IndexValid)
     {
       std::atomic<bool>  escaped{ false };
+      std::atomic<bool>  nonFinite{ false };
       std::vector<float> blockLargest((n + 4095) / 4096, 0.0f);
       parallel(n, [&](SizeValueType begin, SizeValueType end) {
         float top = 0.0f;
@@ -834,7 +849,13 @@ public:
           const float  mf = RoundUp(m);
           m_Motion[i] = mf;
           top = std::max(top, mf);
-          out = out || !(m <= static_cast<double>(m_Skin[i]));
+          const float * box = m_VertexBoxes.data() + 6 * i;
+          out = out || !(box[0] <= q[0] && q[0] <= box[3] && box[1] <= q[1] && q[1] <= box[4] && box[2] <= q[2] &&
+                         q[2] <= box[5]);
+          if (!std::isfinite(m))
+          {
+            nonFinite = true;
+          }
         }
         blockLargest[begin / 4096] = top;
         if (out)
@@ -842,15 +863,27 @@ public:
           escaped = true;
         }
       });
+      if (nonFinite)
+      {
+        return result; // a diverged step: the filter reports it
+      }
       largest = *std::max_element(blockLargest.begin(), blockLargest.end());
       if (escaped)
       {
         m_IndexValid = false;
       }
     }
-    if (!m_IndexValid)
+    const SizeValueType                                       blocks = (numberOfTriangles + 4095) / 4096;
+    std::vector<std::vector<std::pair<IndexType, IndexType>>> found(blocks);
+    const bool                                                rebuild = !m_IndexValid;
+    if (rebuild)
     {
-      this->Build(x, y, minimumDistance, parallel);
+      // The rebuild tests the pairs that may violate as it computes the
+      // clearances.
+      if (!this->Build(x, y, minimumDistance, parallel, found))
+      {
+        return result; // a diverged step: the filter reports it
+      }
       result.rebuilt = true;
       largest = *std::max_element(m_Motion.begin(), m_Motion.end());
     }
@@ -858,38 +891,51 @@ public:
 
     // Triangles that may violate: their motion plus the largest motion reach
     // their clearance; the pairs of two active triangles are tested by the
-    // one of lower index.
-    m_Active.assign(numberOfTriangles, 0);
-    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
-      for (SizeValueType t = begin; t < end; ++t)
-      {
-        const IndexType * v = m_Triangles.data() + 3 * t;
-        const float       mt = std::max({ m_Motion[v[0]], m_Motion[v[1]], m_Motion[v[2]] });
-        m_Active[t] = mt > 0.0f && static_cast<double>(mt) + static_cast<double>(largest) >= m_Clearance[t];
-      }
-    });
-    std::vector<std::vector<std::pair<IndexType, IndexType>>> found((numberOfTriangles + 4095) / 4096);
-    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
-      auto & out = found[begin / 4096];
-      for (SizeValueType t = begin; t < end; ++t)
-      {
-        if (!m_Active[t])
+    // one of lower index, those whose bound at the reference less d exceeds
+    // the two triangles' motions not at all.
+    if (!rebuild)
+    {
+      m_Active.resize(numberOfTriangles);
+      parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+        for (SizeValueType t = begin; t < end; ++t)
         {
-          continue;
+          const IndexType * v = m_Triangles.data() + 3 * t;
+          const float       mt = std::max({ m_Motion[v[0]], m_Motion[v[1]], m_Motion[v[2]] });
+          m_TriangleMotion[t] = mt;
+          m_Active[t] = mt > 0.0f && static_cast<double>(mt) + static_cast<double>(largest) >= m_Clearance[t];
         }
-        m_Grid.ForEachOverlap(t, [&](SizeValueType u) {
-          if ((m_Active[u] && u < t) ||
-              SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
+      });
+      parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+        auto & out = found[begin / 4096];
+        for (SizeValueType t = begin; t < end; ++t)
+        {
+          if (!m_Active[t])
           {
-            return;
+            continue;
           }
-          if (this->Violates(t, u, x, y, d))
-          {
-            out.emplace_back(static_cast<IndexType>(std::min(t, u)), static_cast<IndexType>(std::max(t, u)));
-          }
-        });
-      }
-    });
+          const double * st = m_Spheres.data() + 4 * t;
+          m_Grid.ForEachOverlap(t, [&](SizeValueType u) {
+            if ((m_Active[u] && u < t) ||
+                SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
+            {
+              return;
+            }
+            const double * su = m_Spheres.data() + 4 * u;
+            double         e[3];
+            SurfaceCollisionDetail::Subtract(st, su, e);
+            if (std::sqrt(SurfaceCollisionDetail::Dot(e, e)) - st[3] - su[3] - d >
+                static_cast<double>(m_TriangleMotion[t]) + static_cast<double>(m_TriangleMotion[u]))
+            {
+              return;
+            }
+            if (this->Violates(t, u, x, y, d))
+            {
+              out.emplace_back(static_cast<IndexType>(std::min(t, u)), static_cast<IndexType>(std::max(t, u)));
+            }
+          });
+        }
+      });
+    }
     std::vector<std::pair<IndexType, IndexType>> violating;
     for (const auto & block : found)
     {
@@ -1100,6 +1146,14 @@ private:
         return false;
       }
     }
+    double st[4], su[4], e[3];
+    Sphere(y, vt, st);
+    Sphere(y, vu, su);
+    SurfaceCollisionDetail::Subtract(st, su, e);
+    if (std::sqrt(SurfaceCollisionDetail::Dot(e, e)) - st[3] - su[3] >= d * (1.0 + 1e-12))
+    {
+      return false;
+    }
     const double * a[3] = { y + 3 * vt[0], y + 3 * vt[1], y + 3 * vt[2] };
     const double * b[3] = { y + 3 * vu[0], y + 3 * vu[1], y + 3 * vu[2] };
     const double   next = SurfaceCollisionDetail::TriangleDistance(a, b);
@@ -1112,11 +1166,16 @@ private:
     return next < SurfaceCollisionDetail::TriangleDistance(a0, b0);
   }
 
-  /** Rebuilds the index at the reference positions x; skins from the
-   * proposed displacements y - x; motions |y - x|; clearances. */
+  /** Rebuilds the index at the reference positions x: the points' boxes
+   * from the proposed displacements y - x, motions |y - x|, clearances.
+   * False (and nothing built) when a coordinate is not finite. */
   template <typename TParallel>
-  void
-  Build(const double * x, const double * y, double minimumDistance, TParallel && parallel)
+  bool
+  Build(const double *                                              x,
+        const double *                                              y,
+        double                                                      minimumDistance,
+        TParallel &&                                                parallel,
+        std::vector<std::vector<std::pair<IndexType, IndexType>>> & found)
   {
     const SizeValueType n = m_NumberOfPoints;
     const SizeValueType numberOfTriangles = this->GetNumberOfTriangles();
@@ -1138,38 +1197,52 @@ private:
     const double d = std::max(minimumDistance, m_ContactDistance);
     const double baseSkin = 0.25 * meanEdge;
     m_Reference.assign(x, x + 3 * n);
-    m_Skin.resize(n);
+    m_VertexBoxes.resize(6 * n);
+    std::atomic<bool> finite{ std::isfinite(meanEdge) };
     parallel(n, [&](SizeValueType begin, SizeValueType end) {
+      bool blockFinite = true;
       for (SizeValueType i = begin; i < end; ++i)
       {
         double e[3];
         SurfaceCollisionDetail::Subtract(y + 3 * i, x + 3 * i, e);
         const double m = std::sqrt(SurfaceCollisionDetail::Dot(e, e));
-        const float  mf = RoundUp(m);
-        m_Motion[i] = mf;
-        m_Skin[i] = static_cast<float>(std::max(baseSkin, 1.5 * m));
-        if (!(static_cast<double>(m_Skin[i]) >= m))
+        blockFinite = blockFinite && std::isfinite(m);
+        m_Motion[i] = RoundUp(m);
+        // The box swept by this step and one more of the same displacement,
+        // widened by the base skin.
+        double lo[3], hi[3];
+        for (unsigned int k = 0; k < 3; ++k)
         {
-          m_Skin[i] = mf;
+          const double ahead = x[3 * i + k] + 2.0 * e[k];
+          lo[k] = std::min(x[3 * i + k], ahead);
+          hi[k] = std::max(x[3 * i + k], ahead);
         }
+        SurfaceCollisionDetail::StoreBox(lo, hi, baseSkin, m_VertexBoxes.data() + 6 * i);
+      }
+      if (!blockFinite)
+      {
+        finite = false;
       }
     });
+    if (!finite)
+    {
+      m_IndexValid = false;
+      return false;
+    }
     m_Boxes.resize(6 * numberOfTriangles);
+    m_TriangleMotion.resize(numberOfTriangles);
+    m_Active.assign(numberOfTriangles, 0);
     parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
       for (SizeValueType t = begin; t < end; ++t)
       {
         const IndexType * v = m_Triangles.data() + 3 * t;
-        double            lo[3], hi[3];
+        m_TriangleMotion[t] = std::max({ m_Motion[v[0]], m_Motion[v[1]], m_Motion[v[2]] });
+        double lo[3], hi[3];
         for (unsigned int k = 0; k < 3; ++k)
         {
-          lo[k] = std::numeric_limits<double>::infinity();
-          hi[k] = -std::numeric_limits<double>::infinity();
-          for (unsigned int c = 0; c < 3; ++c)
-          {
-            const double s = m_Skin[v[c]];
-            lo[k] = std::min(lo[k], x[3 * v[c] + k] - s);
-            hi[k] = std::max(hi[k], x[3 * v[c] + k] + s);
-          }
+          lo[k] = std::min({ m_VertexBoxes[6 * v[0] + k], m_VertexBoxes[6 * v[1] + k], m_VertexBoxes[6 * v[2] + k] });
+          hi[k] = std::max(
+            { m_VertexBoxes[6 * v[0] + 3 + k], m_VertexBoxes[6 * v[1] + 3 + k], m_VertexBoxes[6 * v[2] + 3 + k] });
         }
         SurfaceCollisionDetail::StoreBox(lo, hi, 0.5 * d, m_Boxes.data() + 6 * t);
       }
@@ -1178,41 +1251,52 @@ private:
 
     // Clearances: lower bounds, at x, of the distances to the triangles
     // whose boxes overlap, less d: bounding spheres (centroid, largest
-    // distance to a vertex), the exact distance where the spheres' gap is
-    // within twice the base skin.
+    // distance to a vertex), the exact distance where the spheres' gap less
+    // d is below the base skin.
     m_Clearance.resize(numberOfTriangles);
+    m_Spheres.resize(4 * numberOfTriangles);
     parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
       for (SizeValueType t = begin; t < end; ++t)
       {
+        Sphere(x, m_Triangles.data() + 3 * t, m_Spheres.data() + 4 * t);
+      }
+    });
+    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+      auto & out = found[begin / 4096];
+      for (SizeValueType t = begin; t < end; ++t)
+      {
         const IndexType * vt = m_Triangles.data() + 3 * t;
-        double            ct[3];
-        double            rt = 0.0;
-        Sphere(x, vt, ct, rt);
-        double clearance = std::numeric_limits<double>::infinity();
+        const double *    st = m_Spheres.data() + 4 * t;
+        double            clearance = std::numeric_limits<double>::infinity();
         m_Grid.ForEachOverlap(t, [&](SizeValueType u) {
           const IndexType * vu = m_Triangles.data() + 3 * u;
           if (SurfaceCollisionDetail::ShareVertex(vt, vu))
           {
             return;
           }
-          double cu[3];
-          double ru = 0.0;
-          Sphere(x, vu, cu, ru);
-          double e[3];
-          SurfaceCollisionDetail::Subtract(ct, cu, e);
-          double bound = std::sqrt(SurfaceCollisionDetail::Dot(e, e)) - rt - ru;
-          if (bound - d < 2.0 * baseSkin)
+          const double * su = m_Spheres.data() + 4 * u;
+          double         e[3];
+          SurfaceCollisionDetail::Subtract(st, su, e);
+          double bound = std::sqrt(SurfaceCollisionDetail::Dot(e, e)) - st[3] - su[3];
+          if (bound - d < baseSkin)
           {
             const double * a[3] = { x + 3 * vt[0], x + 3 * vt[1], x + 3 * vt[2] };
             const double * b[3] = { x + 3 * vu[0], x + 3 * vu[1], x + 3 * vu[2] };
             bound = std::max(bound, SurfaceCollisionDetail::TriangleDistance(a, b));
           }
           clearance = std::min(clearance, bound - d);
+          if (t < u &&
+              bound - d <= static_cast<double>(m_TriangleMotion[t]) + static_cast<double>(m_TriangleMotion[u]) &&
+              this->Violates(t, u, x, y, d))
+          {
+            out.emplace_back(static_cast<IndexType>(t), static_cast<IndexType>(u));
+          }
         });
         m_Clearance[t] = clearance;
       }
     });
     m_IndexValid = true;
+    return true;
   }
 
   /** m as a float not below it (0 stays 0). */
@@ -1223,8 +1307,10 @@ private:
     return static_cast<double>(f) >= m ? f : std::nextafter(f, std::numeric_limits<float>::infinity());
   }
 
+  /** Bounding sphere of a triangle: centroid c[0..2], radius c[3] (the
+   * largest distance to a vertex). */
   static void
-  Sphere(const double * x, const IndexType * v, double * c, double & r)
+  Sphere(const double * x, const IndexType * v, double * c)
   {
     for (unsigned int k = 0; k < 3; ++k)
     {
@@ -1238,7 +1324,7 @@ private:
       r2 = std::max(r2, SurfaceCollisionDetail::Dot(e, e));
     }
     // Widened by a relative 1e-12: a bound whatever the rounding.
-    r = std::sqrt(r2) * (1.0 + 1e-12);
+    c[3] = std::sqrt(r2) * (1.0 + 1e-12);
   }
 
   SizeValueType              m_NumberOfPoints{ 0 };
@@ -1247,13 +1333,15 @@ private:
   std::vector<SizeValueType> m_VertexTriangleOffsets;
   std::vector<IndexType>     m_VertexTriangles;
 
-  // The index: reference positions, skins, boxes, grid, clearances.
+  // The index: reference positions, points' and triangles' boxes, grid,
+  // clearances.
   bool                            m_IndexValid{ false };
   double                          m_MinimumDistance{ 0.0 };
   double                          m_ContactDistance{ 0.0 };
   SizeValueType                   m_NumberOfRebuilds{ 0 };
   std::vector<double>             m_Reference;
-  std::vector<float>              m_Skin;
+  std::vector<float>              m_VertexBoxes; // per point: the box it may move in
+  std::vector<double>             m_Spheres;     // per triangle at the reference: centre, radius
   std::vector<float>              m_Boxes;
   std::vector<double>             m_Clearance;
   SurfaceCollisionDetail::BoxGrid m_Grid;
@@ -1261,6 +1349,7 @@ private:
   // Per step.
   std::vector<float>     m_Motion;
   std::vector<uint8_t>   m_Active;
+  std::vector<float>     m_TriangleMotion; // largest motion of its points
   std::vector<uint8_t>   m_Level;
   std::vector<IndexType> m_ModifiedPoints;
 };
