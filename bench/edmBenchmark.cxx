@@ -387,7 +387,10 @@ private:
 // ---------------------------------------------------------------------------
 // Our filter: external forces + Elasticity + Rigidity, tangential elasticity.
 void
-RunDeformableMesh(benchmark::State & state, bool internalForces, unsigned int threads)
+RunDeformableMesh(benchmark::State & state,
+                  bool               internalForces,
+                  unsigned int       threads,
+                  bool               preventSelfIntersections = false)
 {
   const int64_t      requested = state.range(0);
   ThreadScope        scope(threads);
@@ -403,6 +406,7 @@ RunDeformableMesh(benchmark::State & state, bool internalForces, unsigned int th
   model->SetRigidity(internalForces ? 0.1 : 0.0);
   model->SetIterateFromZero(false);
   model->SetNumberOfWorkUnits(threads == 1 ? 1 : 4 * threads);
+  model->SetPreventSelfIntersections(preventSelfIntersections);
   model->SetNumberOfIterations(1);
   model->Update(); // Reset(): topology and state, outside the timing.
 
@@ -416,15 +420,27 @@ RunDeformableMesh(benchmark::State & state, bool internalForces, unsigned int th
   state.counters["vertices"] = static_cast<double>(vertices);
   state.counters["vertex_it/s"] =
     benchmark::Counter(static_cast<double>(vertices * stepsRun), benchmark::Counter::kIsRate);
+  if (preventSelfIntersections)
+  {
+    state.counters["collisions"] = static_cast<double>(model->GetTotalNumberOfCollisionsPrevented());
+  }
   state.SetLabel(
     std::string(itk::DeformableMeshFilterDetail::KernelPathName(itk::DeformableMeshFilterDetail::GetKernelPath())) +
-    ", steps/update=" + std::to_string(steps));
+    ", steps/update=" + std::to_string(steps) + (preventSelfIntersections ? ", collision test" : ""));
 }
 
 void
 BM_EDM_DeformableMesh(benchmark::State & state)
 {
   RunDeformableMesh(state, true, static_cast<unsigned int>(state.range(1)));
+}
+
+// The same run with PreventSelfIntersections on (issue 15 item 4): the
+// collision test at every iteration.
+void
+BM_EDM_SelfIntersection(benchmark::State & state)
+{
+  RunDeformableMesh(state, true, static_cast<unsigned int>(state.range(1)), true);
 }
 
 // The same step on each kernel path (0 AVX2+FMA, 1 SSE2, 2 portable), forced
@@ -938,6 +954,12 @@ MeshArguments(benchmark::internal::Benchmark * b, bool threaded)
 
 BENCHMARK(BM_EDM_DeformableMesh)->Apply([](benchmark::internal::Benchmark * b) { MeshArguments(b, true); });
 BENCHMARK(BM_EDM_ExternalOnly)->Apply([](benchmark::internal::Benchmark * b) { MeshArguments(b, true); });
+BENCHMARK(BM_EDM_SelfIntersection)
+  ->ArgsProduct({ { 100000, 1000000 }, { 1, 2 } })
+  ->ArgNames({ "vertices", "threads" })
+  ->UseRealTime()
+  ->Unit(benchmark::kMillisecond)
+  ->ComputeStatistics("max", Largest);
 BENCHMARK(BM_EDM_KernelPath)
   ->ArgsProduct({ { 100000 }, { 0, 1, 2 } })
   ->ArgNames({ "vertices", "path" })
