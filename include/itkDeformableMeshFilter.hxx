@@ -583,12 +583,12 @@ DeformableMeshFilter<TMesh, TForceImage>::ConstrainSelfIntersections(std::vector
     // Turned on after the last reset: set up (and check) now.
     this->ResetCollision(m_CollisionTriangles.empty() ? nullptr : &m_CollisionTriangles, true);
   }
-  const std::vector<double> & coordinates = this->GetCoordinates();
-  const auto                  result = m_Collision.Constrain(coordinates.data(),
-                                            m_NextCoordinates.data(),
-                                            m_MinimumDistance,
-                                            this->GetMultiThreader(),
-                                            this->GetNumberOfWorkUnits());
+  // The state the iteration started from, free of intersections: the
+  // coordinates, or with internal sub-steps (ReferenceEdgeLength) the copy
+  // taken before them. Reduced displacements are measured from it.
+  const std::vector<double> & start = m_NumberOfSubSteps > 1 ? m_IterationStart : this->GetCoordinates();
+  const auto                  result = m_Collision.Constrain(
+    start.data(), m_NextCoordinates.data(), m_MinimumDistance, this->GetMultiThreader(), this->GetNumberOfWorkUnits());
   m_NumberOfCollisionsPrevented = result.violations;
   m_TotalNumberOfCollisionsPrevented += result.violations;
   m_NumberOfConstrainedVertices = result.constrained;
@@ -597,34 +597,30 @@ DeformableMeshFilter<TMesh, TForceImage>::ConstrainSelfIntersections(std::vector
     return;
   }
   // The displacements of the constrained vertices changed: their
-  // diagnostics, and the largest displacement of their blocks.
-  const SizeValueType  numberOfPoints = this->GetNumberOfCachedPoints();
-  std::vector<uint8_t> blocks(blockMaximum.size(), 0);
-  const auto           length = [&](SizeValueType i) {
-    const double dx = m_NextCoordinates[3 * i] - coordinates[3 * i];
-    const double dy = m_NextCoordinates[3 * i + 1] - coordinates[3 * i + 1];
-    const double dz = m_NextCoordinates[3 * i + 2] - coordinates[3 * i + 2];
+  // diagnostics, and the largest displacement (a pass over the vertices, in
+  // the iterations that constrain some only).
+  const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
+  const auto          length = [&](SizeValueType i) {
+    const double dx = m_NextCoordinates[3 * i] - start[3 * i];
+    const double dy = m_NextCoordinates[3 * i + 1] - start[3 * i + 1];
+    const double dz = m_NextCoordinates[3 * i + 2] - start[3 * i + 2];
     return std::sqrt(dx * dx + dy * dy + dz * dz);
   };
-  for (const auto i : m_Collision.GetConstrainedPoints())
+  if (diagnose)
   {
-    blocks[i / BlockSize] = 1;
-    if (diagnose)
+    for (const auto i : m_Collision.GetConstrainedPoints())
     {
       m_DisplacementMagnitudes[i] = static_cast<float>(length(i));
     }
   }
-  for (SizeValueType block = 0; block < blocks.size(); ++block)
+  for (SizeValueType block = 0; block < blockMaximum.size(); ++block)
   {
-    if (blocks[block])
+    double largest = 0.0;
+    for (SizeValueType i = block * BlockSize; i < std::min(numberOfPoints, (block + 1) * BlockSize); ++i)
     {
-      double largest = 0.0;
-      for (SizeValueType i = block * BlockSize; i < std::min(numberOfPoints, (block + 1) * BlockSize); ++i)
-      {
-        largest = std::max(largest, length(i));
-      }
-      blockMaximum[block] = largest;
+      largest = std::max(largest, length(i));
     }
+    blockMaximum[block] = largest;
   }
 }
 
