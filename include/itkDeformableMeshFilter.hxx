@@ -583,6 +583,13 @@ DeformableMeshFilter<TMesh, TForceImage>::ConstrainSelfIntersections(std::vector
     // Turned on after the last reset: set up (and check) now.
     this->ResetCollision(m_CollisionTriangles.empty() ? nullptr : &m_CollisionTriangles, true);
   }
+  if (m_Collision.GetNumberOfPoints() != this->GetNumberOfCachedPoints())
+  {
+    itkExceptionMacro("PreventSelfIntersections: the collision tables describe "
+                      << m_Collision.GetNumberOfPoints() << " points but the mesh has "
+                      << this->GetNumberOfCachedPoints()
+                      << " (a change of the mesh without ResetCollision(): an internal error).");
+  }
   // The state the iteration started from, free of intersections: the
   // coordinates, or with internal sub-steps (ReferenceEdgeLength) the copy
   // taken before them. Reduced displacements are measured from it.

@@ -749,6 +749,11 @@ public:
   }
 
   SizeValueType
+  GetNumberOfPoints() const
+  {
+    return m_NumberOfPoints;
+  }
+  SizeValueType
   GetNumberOfTriangles() const
   {
     return m_Triangles.size() / 3;
