@@ -488,6 +488,14 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
   }
   this->RenumberForLocality(triangles, edges);
   this->BuildTopology(triangles, edges);
+  // The collision test takes the triangles in the cache's numbering when
+  // the points were renumbered (the input's cells otherwise, which also
+  // name the cells of an intersecting pair).
+  std::vector<IndexType32> renumberedTriangles;
+  if (m_Renumbered)
+  {
+    renumberedTriangles = triangles;
+  }
   if (m_RemeshingEdgeLength > 0.0)
   {
     m_Triangles.swap(triangles);
@@ -516,7 +524,7 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
   {
     this->EstimateImageTermModel();
   }
-  this->ResetCollision();
+  this->ResetCollision(m_Renumbered ? &renumberedTriangles : nullptr, true);
 }
 
 template <typename TMesh, typename TForceImage>
@@ -996,6 +1004,9 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
   const bool            unique = m_Remesher.Edges(edges);
   this->BuildTopology(m_Triangles, edges, unique);
   ++m_NumberOfRemeshings;
+  // The collision test's tables for the new mesh (no check: see
+  // ResetCollision()).
+  this->ResetCollision(&m_Triangles, false);
 }
 
 template <typename TMesh, typename TForceImage>
