@@ -294,6 +294,23 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                   RequireInRange("--elasticity", o.elasticity, 0.0, 1.0);
                 } });
   t.push_back({ model,
+                "--prevent-self-intersections",
+                "",
+                "no step lets the surface intersect itself: the displacements of the vertices of colliding "
+                "triangles are halved, then zeroed (slower where the surface moves fast)",
+                "off",
+                [&o](const std::string &) { o.preventSelfIntersections = true; } });
+  t.push_back({ model,
+                "--minimum-distance",
+                "MM",
+                "with --prevent-self-intersections, the smallest distance a step may leave between two triangles "
+                "sharing no vertex, physical units (mm); keep it below half the shortest edge",
+                "0",
+                [&o](const std::string & s) {
+                  o.minimumDistance = ParseDouble("--minimum-distance", s);
+                  RequireAtLeast("--minimum-distance", o.minimumDistance, 0.0);
+                } });
+  t.push_back({ model,
                 "--tangential-elasticity",
                 "",
                 "keep only the component of the elastic force tangent to the surface (it then spaces the vertices "

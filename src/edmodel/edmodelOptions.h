@@ -145,7 +145,9 @@ struct SegmentOptions
   double       rigidity{ defaults::Rigidity };
   double       balloon{ GetCoreDefaults().Balloon };
   double       regionWeight{ -1.0 }; // negative: defaults::RegionWeightInVoxels times the smallest spacing
-  double       regionSigma{ -1.0 };  // negative: defaults::RegionSigmaInVoxels times the smallest spacing
+  bool         preventSelfIntersections{ false };
+  double       minimumDistance{ 0.0 };
+  double       regionSigma{ -1.0 }; // negative: defaults::RegionSigmaInVoxels times the smallest spacing
   double       intensityTolerance{ GetCoreDefaults().IntensityTolerance };
   double       edgeLength{ -1.0 }; // non-positive: defaults::EdgeLengthInVoxels times the smallest spacing
   bool         hasObjectRange{ false };

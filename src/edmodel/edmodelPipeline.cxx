@@ -3,6 +3,7 @@
 // DeformableMeshFilter, with progress reporting. No deformation maths here:
 // the filters do it.
 
+#include "itkSurfaceCollision.h"
 #include "edmodelIO.h"
 #include "edmodelOptions.h"
 
@@ -377,6 +378,55 @@ EnclosedVolume(const MeshType * mesh)
   return std::abs(volume) / 6.0;
 }
 
+/** The final mesh's quality for the summary: intersecting pairs of
+ * triangles sharing no vertex, the smallest angle of its triangles, and its
+ * edge lengths. */
+std::string
+DescribeQuality(const MeshType * mesh)
+{
+  double smallestAngle = 180.0;
+  double shortest = std::numeric_limits<double>::infinity();
+  double longest = 0.0;
+  double sum = 0.0;
+  size_t edges = 0;
+  for (auto it = mesh->GetCells()->Begin(); it != mesh->GetCells()->End(); ++it)
+  {
+    const auto * cell = it.Value();
+    if (cell->GetNumberOfPoints() != 3)
+    {
+      continue;
+    }
+    const auto * ids = cell->GetPointIds();
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      const auto   a = mesh->GetPoint(ids[k]);
+      const auto   b = mesh->GetPoint(ids[(k + 1) % 3]);
+      const auto   c = mesh->GetPoint(ids[(k + 2) % 3]);
+      const auto   u = b - a;
+      const auto   v = c - a;
+      const double length = u.GetNorm();
+      shortest = std::min(shortest, length);
+      longest = std::max(longest, length);
+      sum += length;
+      ++edges;
+      const double denominator = u.GetNorm() * v.GetNorm();
+      if (denominator > 0.0)
+      {
+        const double cosine = std::max(-1.0, std::min(1.0, (u * v) / denominator));
+        smallestAngle = std::min(smallestAngle, std::acos(cosine) * 180.0 / 3.141592653589793);
+      }
+    }
+  }
+  if (edges == 0)
+  {
+    return "no triangles";
+  }
+  const auto intersections = itk::SurfaceCollision::CountSelfIntersections(mesh);
+  return std::to_string(intersections) + " intersecting pairs of triangles, smallest angle " +
+         Format(smallestAngle, 3) + " degrees, edge length " + Format(shortest, 3) + " to " + Format(longest, 3) +
+         " mm (mean " + Format(sum / static_cast<double>(edges), 3) + " mm; interior edges counted twice)";
+}
+
 /** A surface that left the image or collapsed is a failed run (exit 1),
  * not a result: nothing is written. An object cut by the image's edge (the
  * brainstem at the bottom of a head scan) holds the surface at that edge,
@@ -512,6 +562,8 @@ Deform(const ImageType *        image,
     {
       deform->SetObjectIntensityStatistics(model[0], model[1]);
     }
+    deform->SetPreventSelfIntersections(o.preventSelfIntersections);
+    deform->SetMinimumDistance(o.minimumDistance);
     deform->SetMaximumStepLength(o.maximumStepLength);
     deform->SetConvergenceTolerance(o.convergenceTolerance);
     deform->SetConvergenceWindow(o.convergenceWindow);
@@ -713,6 +765,7 @@ RunSegment(const SegmentOptions & o, const GlobalOptions & global)
     std::cout << "edmodel: wrote " << o.output << " (" << result.mesh->GetNumberOfPoints() << " points, "
               << CountSurfaceCells(result.mesh) << " faces) after " << result.iterations << " iterations"
               << (result.converged ? ", converged" : ", not converged") << std::endl;
+    std::cout << "edmodel: surface quality: " << DescribeQuality(result.mesh) << std::endl;
   }
   return ExitSuccess;
 }
