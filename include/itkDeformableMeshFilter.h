@@ -629,11 +629,11 @@ private:
   // The surface's triangles in the internal numbering (remeshing only).
   std::vector<IndexType32> m_Triangles;
   DeformableMeshRemesher   m_Remesher;
-  bool          m_PreventSelfIntersections{ false };
-  double        m_MinimumDistance{ 0.0 };
-  SizeValueType m_NumberOfCollisionsPrevented{ 0 };
-  SizeValueType m_TotalNumberOfCollisionsPrevented{ 0 };
-  SizeValueType m_NumberOfConstrainedVertices{ 0 };
+  bool                     m_PreventSelfIntersections{ false };
+  double                   m_MinimumDistance{ 0.0 };
+  SizeValueType            m_NumberOfCollisionsPrevented{ 0 };
+  SizeValueType            m_TotalNumberOfCollisionsPrevented{ 0 };
+  SizeValueType            m_NumberOfConstrainedVertices{ 0 };
   /** The collision test's tables and index (PreventSelfIntersections). */
   SurfaceCollision m_Collision;
   /** The triangles last given to ResetCollision() (empty: the input's). */
