@@ -21,6 +21,7 @@
 #include "itkIterativeMeshFilter.h"
 #include "itkImage.h"
 #include "itkDeformableMeshFilterDetail.h"
+#include "itkDeformableMeshEdgeSearch.h"
 #include "itkDeformableMeshRegionForce.h"
 #include "itkDeformableMeshRemesher.h"
 #include "itkForceImageCheck.h"
@@ -336,6 +337,43 @@ public:
   itkGetConstMacro(ObjectIntensityMedian, double);
   itkGetConstMacro(ObjectIntensitySpread, double);
 
+  /** Weight of the edge search, the largest displacement per iteration
+   * (mm) it gives along the normal. For each vertex, the intensity profile
+   * along its unit normal (the intensity image smoothed by RegionSigma,
+   * sampled every half voxel from -EdgeSearchDistance to
+   * +EdgeSearchDistance) is searched for the strongest edge of the expected
+   * polarity (EdgePolarity) whose contrast, one voxel on each side, is at
+   * least the object's robust standard deviation (DeformableMeshFilterDetail::
+   * EdgeSearch); the hit is the median of the vertex's and its neighbours'
+   * hits (more than half of them must have found an edge), and the vertex
+   * moves toward it by EdgeSearchWeight x clamp(hit / voxel, -1, 1): at full
+   * weight beyond one voxel (the smallest spacing of the intensity image),
+   * in proportion closer, so that it settles on the edge. It adds to the
+   * region force, which brings the surface within the search distance; on
+   * its own (RegionWeight 0) the object's model is still estimated for the
+   * polarity and the contrast. Keep it below one voxel per iteration.
+   * Non-negative; 0 turns the edge search off. Default: 0. */
+  itkSetMacro(EdgeSearchWeight, double);
+  itkGetConstMacro(EdgeSearchWeight, double);
+
+  /** Half-length of the edge search's profile along the normal, physical
+   * units (mm): the capture range of the edge search on each side of the
+   * surface (at most 64 half-voxel steps are taken). Positive. Default: 2. */
+  itkSetMacro(EdgeSearchDistance, double);
+  itkGetConstMacro(EdgeSearchDistance, double);
+
+  /** The edges the edge search looks for: +1 where the intensity falls
+   * outward (an object brighter than its surroundings), -1 where it rises (a
+   * darker object), 0 (default) from the intensity model: the side of the
+   * object's class where the background's samples lie
+   * (EstimateBackgroundIntensity), or before any background estimate the
+   * side of the image's intensity range farther from the object's median. */
+  itkSetClampMacro(EdgePolarity, int, -1, 1);
+  itkGetConstMacro(EdgePolarity, int);
+
+  /** Vertices that felt the edge search's force at the last iteration. */
+  itkGetConstMacro(NumberOfEdgeHits, SizeValueType);
+
   /** Reference edge length L, physical units (mm): the edge length at which
    * Elasticity and Rigidity have their nominal weight. When positive the
    * internal forces are scaled at each vertex by (L/h)^2 (elasticity) and
@@ -549,7 +587,7 @@ private:
   bool
   UsesImageTerms() const
   {
-    return m_RegionWeight > 0.0;
+    return m_RegionWeight > 0.0 || m_EdgeSearchWeight > 0.0;
   }
 
   /** Sets up the collision test (PreventSelfIntersections) for the current
@@ -596,6 +634,10 @@ private:
   void
   UpdateNormalSpeeds();
 
+  /** Adds the edge search's speeds to m_NormalSpeeds. */
+  void
+  AddEdgeSearchSpeeds();
+
   double        m_ScaleFactor{ 1.0 };
   double        m_Elasticity{ 0.0 };
   bool          m_TangentialElasticity{ true };
@@ -616,6 +658,10 @@ private:
   double        m_ObjectIntensityMedian{ 0.0 };
   double        m_ObjectIntensitySpread{ 0.0 };
   bool          m_ObjectIntensityStatisticsGiven{ false };
+  double        m_EdgeSearchWeight{ 0.0 };
+  double        m_EdgeSearchDistance{ 2.0 };
+  int           m_EdgePolarity{ 0 };
+  SizeValueType m_NumberOfEdgeHits{ 0 };
   bool          m_EstimateBackgroundIntensity{ true };
   unsigned int  m_BackgroundUpdateInterval{ 10 };
   double        m_ConvergenceTolerance{ 0.0 };
@@ -671,6 +717,7 @@ private:
   std::vector<float>   m_Normals;
   std::vector<uint8_t> m_BalloonReleased;
   std::vector<float>   m_NormalSpeeds;   // image terms only
+  std::vector<float>   m_EdgeHits;       // edge search: distance to the edge along the normal, NaN: none
   std::vector<double>  m_IterationStart; // coordinates at the start of an iteration of several sub-steps
 
   // Image terms: the smoothed intensity image (kept while the input image and

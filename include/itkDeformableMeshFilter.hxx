@@ -102,7 +102,7 @@ DeformableMeshFilter<TMesh, TForceImage>::GenerateData()
 {
   this->PrepareForceSampler();
   m_ForceImageCheck.Verify(
-    this->GetForceImage(), m_ScaleFactor, std::abs(m_Balloon) + m_RegionWeight, m_MaximumStepLength);
+    this->GetForceImage(), m_ScaleFactor, std::abs(m_Balloon) + m_RegionWeight + m_EdgeSearchWeight, m_MaximumStepLength);
   if (this->UsesImageTerms())
   {
     this->PrepareImageTerms();
@@ -520,6 +520,8 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
   m_QuietIterations = 0;
   m_LastMaximumDisplacement = 0.0;
   m_NormalSpeeds.clear();
+  m_EdgeHits.clear();
+  m_NumberOfEdgeHits = 0;
   if (this->UsesImageTerms())
   {
     this->EstimateImageTermModel();
@@ -998,6 +1000,7 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
   std::vector<float>().swap(m_Umbrella);
   std::vector<float>().swap(m_Normals);
   std::vector<float>().swap(m_NormalSpeeds);
+  std::vector<float>().swap(m_EdgeHits);
 
   this->SetCachedTriangles(newNumberOfPoints, m_Triangles);
   std::vector<uint64_t> edges;
@@ -1021,6 +1024,10 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "Balloon: " << m_Balloon << std::endl;
   os << indent << "RegionWeight: " << m_RegionWeight << std::endl;
   os << indent << "RegionSigma: " << m_RegionSigma << std::endl;
+  os << indent << "EdgeSearchWeight: " << m_EdgeSearchWeight << std::endl;
+  os << indent << "EdgeSearchDistance: " << m_EdgeSearchDistance << std::endl;
+  os << indent << "EdgePolarity: " << m_EdgePolarity << std::endl;
+  os << indent << "NumberOfEdgeHits: " << m_NumberOfEdgeHits << std::endl;
   os << indent << "IntensityTolerance: " << m_IntensityTolerance << std::endl;
   os << indent << "EstimateObjectIntensityRange: " << m_EstimateObjectIntensityRange << std::endl;
   os << indent << "ObjectIntensityRange: [" << m_ObjectIntensityLower << ", " << m_ObjectIntensityUpper << "], width "

@@ -64,6 +64,19 @@ DeformableMeshFilter<TMesh, TForceImage>::VerifyImageTermParameters() const
                       << m_ObjectIntensityLower << ", " << m_ObjectIntensityUpper << "], width "
                       << m_ObjectIntensityWidth << ".");
   }
+  if (!(m_EdgeSearchWeight >= 0.0 && std::isfinite(m_EdgeSearchWeight)))
+  {
+    itkExceptionMacro("EdgeSearchWeight must be finite and non-negative; it is " << m_EdgeSearchWeight << ".");
+  }
+  if (!(m_EdgeSearchDistance > 0.0 && std::isfinite(m_EdgeSearchDistance)))
+  {
+    itkExceptionMacro("EdgeSearchDistance must be finite and positive; it is " << m_EdgeSearchDistance << ".");
+  }
+  if (m_EdgeSearchWeight > 0.0 && this->GetIntensityImage() == nullptr)
+  {
+    itkExceptionMacro("EdgeSearchWeight is " << m_EdgeSearchWeight
+                                             << " but there is no intensity image: call SetIntensityImage().");
+  }
   if (m_RegionWeight > 0.0 && this->GetIntensityImage() == nullptr)
   {
     itkExceptionMacro("RegionWeight is " << m_RegionWeight
@@ -264,10 +277,117 @@ DeformableMeshFilter<TMesh, TForceImage>::UpdateNormalSpeeds()
       const SizeValueType end = std::min(numberOfPoints, (block + 1) * blockSize);
       for (SizeValueType i = block * blockSize; i < end; ++i)
       {
-        speeds[i] = static_cast<float>(weight * m_RegionForce.Speed(m_IntensitySampler.Sample(x + 3 * i)));
+        speeds[i] =
+          weight > 0.0 ? static_cast<float>(weight * m_RegionForce.Speed(m_IntensitySampler.Sample(x + 3 * i))) : 0.0f;
       }
     },
     nullptr);
+  if (m_EdgeSearchWeight > 0.0 && m_Normals.size() == 4 * numberOfPoints)
+  {
+    this->AddEdgeSearchSpeeds();
+  }
+  else
+  {
+    m_NumberOfEdgeHits = 0;
+  }
+}
+
+template <typename TMesh, typename TForceImage>
+void
+DeformableMeshFilter<TMesh, TForceImage>::AddEdgeSearchSpeeds()
+{
+  using DeformableMeshFilterDetail::EdgeSearch;
+  const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
+  const double *      x = this->GetCoordinates().data();
+  const float *       normals = m_Normals.data();
+  float *             speeds = m_NormalSpeeds.data();
+  m_EdgeHits.resize(numberOfPoints);
+  float * hits = m_EdgeHits.data();
+
+  int polarity = m_EdgePolarity;
+  if (polarity == 0)
+  {
+    if (m_EstimateObjectIntensityRange || m_ObjectIntensityStatisticsGiven)
+    {
+      polarity = m_RegionForce.Polarity(m_IntensityQuantiles[0], m_IntensityQuantiles[1]);
+    }
+    else
+    {
+      const double middle = 0.5 * (m_RegionForce.GetLower() + m_RegionForce.GetUpper());
+      polarity = middle - m_IntensityQuantiles[0] >= m_IntensityQuantiles[1] - middle ? 1 : -1;
+    }
+  }
+  // An edge must drop by at least the object's robust standard deviation
+  // (the transition width for a given range): noise inside the object does
+  // not make one.
+  const double contrast = (m_EstimateObjectIntensityRange || m_ObjectIntensityStatisticsGiven)
+                            ? m_ObjectIntensitySpread * m_IntensityScale
+                            : m_RegionForce.GetWidth();
+  EdgeSearch   search;
+  search.Configure(m_EdgeSearchDistance, 0.5 * m_BackgroundStep, m_BackgroundStep, polarity, contrast);
+
+  constexpr SizeValueType blockSize = 4096;
+  const SizeValueType     numberOfBlocks = (numberOfPoints + blockSize - 1) / blockSize;
+  MultiThreaderBase *     threader = this->GetMultiThreader();
+  threader->ParallelizeArray(
+    0,
+    numberOfBlocks,
+    [&](SizeValueType block) {
+      const SizeValueType end = std::min(numberOfPoints, (block + 1) * blockSize);
+      for (SizeValueType i = block * blockSize; i < end; ++i)
+      {
+        hits[i] = static_cast<float>(search.Find(m_IntensitySampler, x + 3 * i, normals + 4 * i));
+      }
+    },
+    nullptr);
+
+  // The median of the vertex's and its neighbours' hits, when more than half
+  // of them found an edge: a single vertex's hit on noise or on a
+  // neighbouring structure does not move it.
+  const double          weight = m_EdgeSearchWeight;
+  const double          inverseVoxel = 1.0 / m_BackgroundStep;
+  std::vector<uint32_t> blockHits(numberOfBlocks, 0);
+  threader->ParallelizeArray(
+    0,
+    numberOfBlocks,
+    [&](SizeValueType block) {
+      constexpr unsigned int capacity = 32;
+      float                  values[capacity];
+      uint32_t               count = 0;
+      const SizeValueType    end = std::min(numberOfPoints, (block + 1) * blockSize);
+      for (SizeValueType i = block * blockSize; i < end; ++i)
+      {
+        unsigned int found = 0;
+        unsigned int total = 1;
+        if (std::isfinite(hits[i]))
+        {
+          values[found++] = hits[i];
+        }
+        for (IndexType32 k = m_NeighbourOffsets[i]; k < m_NeighbourOffsets[i + 1] && total < capacity; ++k, ++total)
+        {
+          const float hit = hits[m_Neighbours[k]];
+          if (std::isfinite(hit))
+          {
+            values[found++] = hit;
+          }
+        }
+        if (2 * found <= total)
+        {
+          continue;
+        }
+        std::nth_element(values, values + found / 2, values + found);
+        const double distance = values[found / 2];
+        speeds[i] += static_cast<float>(weight * std::max(-1.0, std::min(1.0, distance * inverseVoxel)));
+        ++count;
+      }
+      blockHits[block] = count;
+    },
+    nullptr);
+  m_NumberOfEdgeHits = 0;
+  for (const uint32_t count : blockHits)
+  {
+    m_NumberOfEdgeHits += count;
+  }
 }
 
 } // end namespace itk

@@ -238,6 +238,8 @@ public:
       halfWidth = std::max(0.5 * (centre - low), 0.5 * (high - centre));
     }
     m_Centre = centre;
+    m_DarkSamples = 0;
+    m_BrightSamples = 0;
     m_ClassLower = centre - halfWidth;
     m_ClassUpper = centre + halfWidth;
     SetRange(m_ClassLower, m_ClassUpper, std::max(0.5 * spread, 0.125 * halfWidth));
@@ -276,6 +278,8 @@ public:
         bright.push_back(value);
       }
     }
+    m_DarkSamples = dark.size();
+    m_BrightSamples = bright.size();
     const size_t minimum = std::max<size_t>(16, samples.size() / 20);
     const double lower = dark.size() >= minimum ? 0.5 * (m_Centre + Median(dark)) : m_ClassLower;
     const double upper = bright.size() >= minimum ? 0.5 * (m_Centre + Median(bright)) : m_ClassUpper;
@@ -393,6 +397,22 @@ public:
     return m_Width;
   }
 
+  /** +1 when the object is brighter than its surroundings (the intensity
+   * falls outward across its boundary), -1 when it is darker: the side of
+   * the class that held more of the background's samples at the last
+   * AdaptToBackground(), or, before any, the side of the image's intensity
+   * range (its 2nd and 98th percentiles low and high) farther from the
+   * object's median. */
+  int
+  Polarity(double low, double high) const
+  {
+    if (m_DarkSamples != m_BrightSamples)
+    {
+      return m_DarkSamples > m_BrightSamples ? 1 : -1;
+    }
+    return m_Centre - low >= high - m_Centre ? 1 : -1;
+  }
+
   /** Outward speed in [-1, 1] for intensity value (NaN: outside the image,
    * -1). */
   double
@@ -416,6 +436,8 @@ private:
   }
 
   double m_MinimumWidth{ 0.0 };
+  size_t m_DarkSamples{ 0 };
+  size_t m_BrightSamples{ 0 };
   double m_Centre{ 0.0 };
   double m_ClassLower{ 0.0 };
   double m_ClassUpper{ 0.0 };

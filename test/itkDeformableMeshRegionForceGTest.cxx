@@ -23,6 +23,8 @@
 #include "itkDeformableMeshFilter.h"
 #include "itkEllipsoidPhantom.h"
 
+#include "itkSmoothingRecursiveGaussianImageFilter.h"
+
 #include "gtest/gtest.h"
 
 #include <cmath>
@@ -229,6 +231,102 @@ TEST(DeformableMeshRegionForce, DarkBallOnBrightBackground)
   RadialError(filter->GetOutput(), mean, maximum);
   EXPECT_LT(mean, 0.25);
   EXPECT_LT(maximum, 0.5);
+}
+
+TEST(DeformableMeshEdgeSearch, FindsTheStrongestEdgeOfItsPolarity)
+{
+  // A bright ball (radius 12) on a dark background, smoothed by the filter
+  // (RegionSigma 1): from a point 1.5 mm inside the boundary along the
+  // outward normal, the falling edge is 1.5 mm out; the search of the other
+  // polarity finds none (the profile only falls), nor does a search whose
+  // minimum contrast is above the ball's.
+  const ImageType::Pointer image = MakeBall(100.0f, 20.0f);
+  using SmoothingType = itk::SmoothingRecursiveGaussianImageFilter<ImageType, ImageType>;
+  auto smoothing = SmoothingType::New();
+  smoothing->SetInput(image);
+  smoothing->SetSigma(1.0);
+  smoothing->Update();
+  itk::DeformableMeshFilterDetail::IntensitySampler sampler;
+  sampler.SetImage(smoothing->GetOutput());
+  const double                                x[3] = { Centre + Radius - 1.5, Centre, Centre };
+  const float                                 n[3] = { 1.0f, 0.0f, 0.0f };
+  itk::DeformableMeshFilterDetail::EdgeSearch search;
+  search.Configure(3.0, 0.5, 1.0, 1, 10.0);
+  EXPECT_EQ(search.GetDistance(), 3.0);
+  // The binary ball's boundary on this axis lies between the voxel centres
+  // 35 and 36, at Centre + Radius.
+  EXPECT_NEAR(search.Find(sampler, x, n), 1.5, 0.1);
+  search.Configure(3.0, 0.5, 1.0, -1, 10.0);
+  EXPECT_TRUE(std::isnan(search.Find(sampler, x, n)));
+  search.Configure(3.0, 0.5, 1.0, 1, 90.0);
+  EXPECT_TRUE(std::isnan(search.Find(sampler, x, n)));
+  // Beyond the search distance: no edge.
+  const double far[3] = { Centre + Radius - 6.0, Centre, Centre };
+  search.Configure(3.0, 0.5, 1.0, 1, 10.0);
+  EXPECT_TRUE(std::isnan(search.Find(sampler, far, n)));
+}
+
+TEST(DeformableMeshEdgeSearch, EdgeSearchAloneSettlesOnTheBoundary)
+{
+  // The edge search alone (no region force), from a sphere of radius 10 in
+  // the ball of radius 12, for a bright and a dark ball (polarity from the
+  // intensity model): the surface stops on the boundary, the same after 300
+  // and 1200 iterations. The binary boundary lies half a voxel beyond the
+  // last voxel inside: mean error measured against Radius + 0.5.
+  for (const float inside : { 100.0f, -300.0f })
+  {
+    const ImageType::Pointer image = MakeBall(inside, inside > 0.0f ? 20.0f : 900.0f);
+    double                   means[2];
+    unsigned int             k = 0;
+    for (unsigned int iterations : { 300u, 1200u })
+    {
+      MeshType::PointType centre;
+      centre.Fill(Centre);
+      auto filter = FilterType::New();
+      filter->SetInput(itk::MakeSphereMesh<MeshType>(centre, 10.0, 4));
+      filter->SetForceImage(MakeZeroForces(image));
+      filter->SetIntensityImage(image);
+      filter->SetScaleFactor(0.0);
+      filter->SetEdgeSearchWeight(0.25);
+      filter->SetEdgeSearchDistance(3.0);
+      filter->SetElasticity(0.3);
+      filter->SetTangentialElasticity(false);
+      filter->SetRigidity(0.05);
+      filter->SetNumberOfIterations(iterations);
+      filter->Update();
+      EXPECT_EQ(filter->GetNumberOfEdgeHits(), filter->GetOutput()->GetNumberOfPoints());
+      double sum = 0.0;
+      double largest = 0.0;
+      for (auto it = filter->GetOutput()->GetPoints()->Begin(); it != filter->GetOutput()->GetPoints()->End(); ++it)
+      {
+        const double error = it.Value().EuclideanDistanceTo(centre) - Radius;
+        sum += std::abs(error);
+        largest = std::max(largest, std::abs(error));
+      }
+      means[k] = sum / filter->GetOutput()->GetNumberOfPoints();
+      EXPECT_LT(means[k], 0.25) << inside << ", " << iterations << " iterations";
+      EXPECT_LT(largest, 0.5) << inside << ", " << iterations << " iterations";
+      ++k;
+    }
+    EXPECT_NEAR(means[0], means[1], 0.02) << inside;
+  }
+}
+
+TEST(DeformableMeshEdgeSearch, BadParameters)
+{
+  const ImageType::Pointer  image = MakeBall(100.0f, 20.0f);
+  const FilterType::Pointer filter = MakeFilter(image, 5);
+  filter->SetEdgeSearchWeight(-1.0);
+  EXPECT_THROW(filter->Update(), itk::ExceptionObject);
+  filter->SetEdgeSearchWeight(std::nan(""));
+  EXPECT_THROW(filter->Update(), itk::ExceptionObject);
+  filter->SetEdgeSearchWeight(0.25);
+  filter->SetEdgeSearchDistance(0.0);
+  EXPECT_THROW(filter->Update(), itk::ExceptionObject);
+  filter->SetEdgeSearchDistance(2.0);
+  EXPECT_NO_THROW(filter->Update());
+  filter->SetEdgePolarity(5);
+  EXPECT_EQ(filter->GetEdgePolarity(), 1);
 }
 
 TEST(DeformableMeshRegionForce, GivenRangeAndBadParameters)
