@@ -352,6 +352,29 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                   RequireAtLeast("--region", o.regionWeight, 0.0);
                 } });
   t.push_back({ model,
+                "--edge-search",
+                "MM",
+                "weight of the edge search: largest displacement per iteration toward the strongest edge of the "
+                "object's polarity found along the normal within --edge-search-distance (median of the vertex's and "
+                "its neighbours' hits), physical units (mm); 0 turns it off",
+                FormatNumber(defaults::EdgeSearchWeightInVoxels) + " x the smallest voxel spacing",
+                [&o](const std::string & s) {
+                  o.edgeSearchWeight = ParseDouble("--edge-search", s);
+                  RequireAtLeast("--edge-search", o.edgeSearchWeight, 0.0);
+                } });
+  t.push_back({ model,
+                "--edge-search-distance",
+                "MM",
+                "how far the edge search looks on each side of the surface along the normal, physical units (mm)",
+                FormatNumber(defaults::EdgeSearchDistanceInVoxels) + " x the smallest voxel spacing",
+                [&o](const std::string & s) {
+                  o.edgeSearchDistance = ParseDouble("--edge-search-distance", s);
+                  if (!(o.edgeSearchDistance > 0.0 && std::isfinite(o.edgeSearchDistance)))
+                  {
+                    throw Error("--edge-search-distance must be positive and finite, got " + s);
+                  }
+                } });
+  t.push_back({ model,
                 "--edge-length",
                 "MM",
                 "mean edge length the surface is refined to: it converges at its initial resolution, then each "

@@ -63,7 +63,7 @@ constexpr double Elasticity = 0.3;
 constexpr bool         TangentialElasticity = false;
 constexpr double       Rigidity = 0.05;
 constexpr unsigned int Iterations = 500;
-constexpr double       ConvergenceTolerance = 0.01;
+constexpr double       ConvergenceTolerance = 0.02;
 /** Subdivisions of the octahedron of --init-sphere (4 * 4^n + 2 points). */
 constexpr unsigned int SphereResolution = 4;
 /** Radius of the default initial sphere, as a fraction of the smallest
@@ -74,10 +74,18 @@ constexpr unsigned int SnapshotEvery = 10;
  * of the smallest voxel spacing, and the smoothing of its image in voxels. */
 constexpr double RegionWeightInVoxels = 0.25;
 constexpr double RegionSigmaInVoxels = 1.0;
+/** Edge search: largest displacement per iteration toward the edge found
+ * along the normal, and how far it looks on each side, in voxels of the
+ * smallest spacing. */
+constexpr double EdgeSearchWeightInVoxels = 0.0;
+constexpr double EdgeSearchDistanceInVoxels = 2.0;
 /** Mean edge length the coarse-to-fine refinement aims at, in voxels of the
  * smallest spacing, and the largest number of points it creates. */
 constexpr double       EdgeLengthInVoxels = 1.0;
 constexpr unsigned int MaximumRefinedPoints = 2000000;
+/** Levels whose mean edge is below this many --edge-length have their
+ * region weight scaled by the square of the ratio (edmodelPipeline.cxx). */
+constexpr double FineLevelEdgeLengths = 2.0;
 /** The first level's region force sees the image smoothed this many times
  * more than the later ones. */
 constexpr double CoarseRegionSigmaFactor = 2.0;
@@ -140,19 +148,21 @@ struct SegmentOptions
   double       gradientVectorFlowRegularization{ GetCoreDefaults().GradientVectorFlowRegularization };
   unsigned int gradientVectorFlowIterations{ GetCoreDefaults().GradientVectorFlowIterations };
 
-  double       elasticity{ defaults::Elasticity };
-  bool         tangentialElasticity{ defaults::TangentialElasticity };
-  double       rigidity{ defaults::Rigidity };
-  double       balloon{ GetCoreDefaults().Balloon };
-  double       regionWeight{ -1.0 }; // negative: defaults::RegionWeightInVoxels times the smallest spacing
-  bool         preventSelfIntersections{ false };
-  double       minimumDistance{ 0.0 };
-  double       regionSigma{ -1.0 }; // negative: defaults::RegionSigmaInVoxels times the smallest spacing
-  double       intensityTolerance{ GetCoreDefaults().IntensityTolerance };
-  double       edgeLength{ -1.0 }; // non-positive: defaults::EdgeLengthInVoxels times the smallest spacing
-  bool         hasObjectRange{ false };
-  double       objectRange[2]{ 0.0, 0.0 };
-  double       maximumStepLength{ GetCoreDefaults().MaximumStepLength };
+  double elasticity{ defaults::Elasticity };
+  bool   tangentialElasticity{ defaults::TangentialElasticity };
+  double rigidity{ defaults::Rigidity };
+  double balloon{ GetCoreDefaults().Balloon };
+  double regionWeight{ -1.0 }; // negative: defaults::RegionWeightInVoxels times the smallest spacing
+  bool   preventSelfIntersections{ false };
+  double minimumDistance{ 0.0 };
+  double edgeSearchWeight{ -1.0 };   // negative: defaults::EdgeSearchWeightInVoxels times the smallest spacing
+  double edgeSearchDistance{ -1.0 }; // non-positive: defaults::EdgeSearchDistanceInVoxels times the smallest spacing
+  double regionSigma{ -1.0 };        // negative: defaults::RegionSigmaInVoxels times the smallest spacing
+  double intensityTolerance{ GetCoreDefaults().IntensityTolerance };
+  double edgeLength{ -1.0 }; // non-positive: defaults::EdgeLengthInVoxels times the smallest spacing
+  bool   hasObjectRange{ false };
+  double objectRange[2]{ 0.0, 0.0 };
+  double maximumStepLength{ GetCoreDefaults().MaximumStepLength };
   unsigned int iterations{ defaults::Iterations };
   double       convergenceTolerance{ defaults::ConvergenceTolerance };
   unsigned int convergenceWindow{ GetCoreDefaults().ConvergenceWindow };

@@ -523,6 +523,10 @@ Deform(const ImageType *        image,
     o.regionWeight >= 0.0 ? o.regionWeight : defaults::RegionWeightInVoxels * SmallestSpacing(image);
   const double regionSigma =
     o.regionSigma >= 0.0 ? o.regionSigma : defaults::RegionSigmaInVoxels * SmallestSpacing(image);
+  const double edgeSearchWeight =
+    o.edgeSearchWeight >= 0.0 ? o.edgeSearchWeight : defaults::EdgeSearchWeightInVoxels * SmallestSpacing(image);
+  const double edgeSearchDistance =
+    o.edgeSearchDistance > 0.0 ? o.edgeSearchDistance : defaults::EdgeSearchDistanceInVoxels * SmallestSpacing(image);
   const double edgeLength = o.edgeLength > 0.0 ? o.edgeLength : defaults::EdgeLengthInVoxels * SmallestSpacing(image);
   MeshType::ConstPointer stageInput = initial;
   // The object's intensity model (median and spread) is estimated once, from
@@ -551,9 +555,19 @@ Deform(const ImageType *        image,
     deform->SetRigidity(o.rigidity);
     deform->SetBalloon(o.balloon);
     deform->SetIntensityImage(image);
-    deform->SetRegionWeight(regionWeight);
+    // On refined levels finer than FineLevelEdgeLengths x --edge-length the region
+    // force is weighted by (h / that length)^2, h the level's mean edge: the
+    // membrane force of a mesh of edge h bends the surface by about
+    // a h^2 kappa / 4 per iteration, so the curvature at which it balances
+    // the region force stays that of the coarser level (the surface does not
+    // creep into sulci and fissures as its mesh is refined), and the finest
+    // level converges within its iterations.
+    const double levelEdge = MeanEdgeLength(stageInput) / (defaults::FineLevelEdgeLengths * edgeLength);
+    deform->SetRegionWeight(stage == 0 ? regionWeight : regionWeight * std::min(1.0, levelEdge * levelEdge));
     deform->SetRegionSigma(stage == 0 && !last ? defaults::CoarseRegionSigmaFactor * regionSigma : regionSigma);
     deform->SetIntensityTolerance(o.intensityTolerance);
+    deform->SetEdgeSearchWeight(edgeSearchWeight);
+    deform->SetEdgeSearchDistance(edgeSearchDistance);
     if (o.hasObjectRange)
     {
       deform->SetObjectIntensityRange(o.objectRange[0], o.objectRange[1], 0.1 * (o.objectRange[1] - o.objectRange[0]));

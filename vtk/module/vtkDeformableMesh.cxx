@@ -85,6 +85,8 @@ vtkDeformableMesh::vtkDeformableMesh()
   this->ConvergenceWindow = static_cast<int>(filter->GetConvergenceWindow());
   this->RegionWeight = filter->GetRegionWeight();
   this->RegionSigma = filter->GetRegionSigma();
+  this->EdgeSearchWeight = filter->GetEdgeSearchWeight();
+  this->EdgeSearchDistance = filter->GetEdgeSearchDistance();
   this->IntensityTolerance = filter->GetIntensityTolerance();
   this->SetInputArrayToProcess(0, 1, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::VECTORS);
   this->SetInputArrayToProcess(1, 1, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
@@ -197,13 +199,13 @@ vtkDeformableMesh::PrepareFilter(vtkInformationVector ** inputVector)
   }
 
   auto * filter = internals.Filter.GetPointer();
-  if (this->RegionWeight > 0.0)
+  if (this->RegionWeight > 0.0 || this->EdgeSearchWeight > 0.0)
   {
     vtkDataArray * intensities = this->GetInputArrayToProcess(1, inputVector);
     if (intensities == nullptr || intensities->GetNumberOfComponents() != 1 ||
         intensities->GetNumberOfTuples() != image->GetNumberOfPoints())
     {
-      vtkErrorMacro("RegionWeight is " << this->RegionWeight
+      vtkErrorMacro("RegionWeight is " << this->RegionWeight << " and EdgeSearchWeight " << this->EdgeSearchWeight
                                        << " but the image on input port 1 has no one-component point array of "
                                           "intensities matching SetInputArrayToProcess(1, ...) (default: the active "
                                           "scalars).");
@@ -239,6 +241,8 @@ vtkDeformableMesh::PrepareFilter(vtkInformationVector ** inputVector)
   }
   filter->SetRegionWeight(this->RegionWeight);
   filter->SetRegionSigma(this->RegionSigma);
+  filter->SetEdgeSearchWeight(this->EdgeSearchWeight);
+  filter->SetEdgeSearchDistance(this->EdgeSearchDistance);
   filter->SetIntensityTolerance(this->IntensityTolerance);
   filter->SetScaleFactor(this->ScaleFactor);
   filter->SetElasticity(this->Elasticity);
@@ -293,6 +297,8 @@ vtkDeformableMesh::PrintSelf(ostream & os, vtkIndent indent)
   os << indent << "Balloon: " << this->Balloon << "\n";
   os << indent << "RegionWeight: " << this->RegionWeight << "\n";
   os << indent << "RegionSigma: " << this->RegionSigma << "\n";
+  os << indent << "EdgeSearchWeight: " << this->EdgeSearchWeight << "\n";
+  os << indent << "EdgeSearchDistance: " << this->EdgeSearchDistance << "\n";
   os << indent << "IntensityTolerance: " << this->IntensityTolerance << "\n";
   os << indent << "MaximumStepLength: " << this->MaximumStepLength << "\n";
   os << indent << "RemeshingEdgeLength: " << this->RemeshingEdgeLength << "\n";

@@ -165,6 +165,27 @@ public:
 
   ///@{
   /**
+   * Edge search: the largest displacement per iteration toward the strongest
+   * edge of the object's polarity found along the normal. Millimetres per
+   * iteration, at least 0; default 0 (off).
+   * Meaning in full: itk::DeformableMeshFilter::SetEdgeSearchWeight().
+   */
+  vtkSetClampMacro(EdgeSearchWeight, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(EdgeSearchWeight, double);
+  ///@}
+
+  ///@{
+  /**
+   * How far the edge search looks on each side of the surface along the
+   * normal. Millimetres, positive; default 2.
+   * Meaning in full: itk::DeformableMeshFilter::SetEdgeSearchDistance().
+   */
+  vtkSetClampMacro(EdgeSearchDistance, double, 1e-6, VTK_DOUBLE_MAX);
+  vtkGetMacro(EdgeSearchDistance, double);
+  ///@}
+
+  ///@{
+  /**
    * Half-width of the estimated object intensity range, in robust standard
    * deviations. Positive; default 2.2.
    * Meaning in full: itk::DeformableMeshFilter::SetIntensityTolerance().
@@ -266,6 +287,8 @@ protected:
   int         RemeshingInterval = 10;
   double      RegionWeight = 0.0;
   double      RegionSigma = 1.0;
+  double      EdgeSearchWeight = 0.0;
+  double      EdgeSearchDistance = 2.0;
   double      IntensityTolerance = 2.2;
   double      ConvergenceTolerance = 0.0;
   int         ConvergenceWindow = 3;

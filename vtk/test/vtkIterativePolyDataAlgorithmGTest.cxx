@@ -726,6 +726,8 @@ TEST(VTKIterativeAlgorithms, PrintSelfPrintsEveryParameter)
                              "Balloon: 0.125",
                              "RegionWeight",
                              "RegionSigma",
+                             "EdgeSearchWeight",
+                             "EdgeSearchDistance",
                              "IntensityTolerance",
                              "MaximumStepLength",
                              "RemeshingEdgeLength",
