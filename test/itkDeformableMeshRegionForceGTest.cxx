@@ -95,14 +95,15 @@ RadialError(const MeshType * mesh, double & mean, double & maximum)
 }
 
 /** The region force alone (no external force, full umbrella elasticity and
- * a little rigidity), from a sphere of radius 5 at the ball's centre. */
+ * a little rigidity), from a sphere of the given radius at the ball's
+ * centre. */
 FilterType::Pointer
-MakeFilter(const ImageType * image, unsigned int iterations)
+MakeFilter(const ImageType * image, unsigned int iterations, double radius = 5.0)
 {
   MeshType::PointType centre;
   centre.Fill(Centre);
   auto filter = FilterType::New();
-  filter->SetInput(itk::MakeSphereMesh<MeshType>(centre, 5.0, 4));
+  filter->SetInput(itk::MakeSphereMesh<MeshType>(centre, radius, 4));
   filter->SetForceImage(MakeZeroForces(image));
   filter->SetIntensityImage(image);
   filter->SetScaleFactor(0.0);
@@ -282,17 +283,10 @@ TEST(DeformableMeshEdgeSearch, EdgeSearchAloneSettlesOnTheBoundary)
     {
       MeshType::PointType centre;
       centre.Fill(Centre);
-      auto filter = FilterType::New();
-      filter->SetInput(itk::MakeSphereMesh<MeshType>(centre, 10.0, 4));
-      filter->SetForceImage(MakeZeroForces(image));
-      filter->SetIntensityImage(image);
-      filter->SetScaleFactor(0.0);
+      const FilterType::Pointer filter = MakeFilter(image, iterations, 10.0);
+      filter->SetRegionWeight(0.0);
       filter->SetEdgeSearchWeight(0.25);
       filter->SetEdgeSearchDistance(3.0);
-      filter->SetElasticity(0.3);
-      filter->SetTangentialElasticity(false);
-      filter->SetRigidity(0.05);
-      filter->SetNumberOfIterations(iterations);
       filter->Update();
       EXPECT_EQ(filter->GetNumberOfEdgeHits(), filter->GetOutput()->GetNumberOfPoints());
       double sum = 0.0;
