@@ -101,8 +101,10 @@ void
 DeformableMeshFilter<TMesh, TForceImage>::GenerateData()
 {
   this->PrepareForceSampler();
-  m_ForceImageCheck.Verify(
-    this->GetForceImage(), m_ScaleFactor, std::abs(m_Balloon) + m_RegionWeight + m_EdgeSearchWeight, m_MaximumStepLength);
+  m_ForceImageCheck.Verify(this->GetForceImage(),
+                           m_ScaleFactor,
+                           std::abs(m_Balloon) + m_RegionWeight + m_EdgeSearchWeight,
+                           m_MaximumStepLength);
   if (this->UsesImageTerms())
   {
     this->PrepareImageTerms();
