@@ -287,7 +287,8 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                 "--elasticity",
                 "A",
                 "weight of the elastic (membrane) force pulling each vertex toward the centroid of its neighbours, "
-                "dimensionless in [0, 1]",
+                "dimensionless in [0, 1]; with the coarse-to-fine schedule it sets the refined levels (the first, "
+                "capture level keeps the default)",
                 FormatNumber(defaults::Elasticity),
                 [&o](const std::string & s) {
                   o.elasticity = ParseDouble("--elasticity", s);
@@ -328,7 +329,8 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                 "--rigidity",
                 "B",
                 "weight of the rigidity (bending) force, the umbrella operator applied twice, dimensionless in [0, 1] "
-                "(elasticity + 2 x rigidity above 1 is scaled down to 1)",
+                "(elasticity + 2 x rigidity above 1 is scaled down to 1); like --elasticity, it sets the refined "
+                "levels of the coarse-to-fine schedule",
                 FormatNumber(defaults::Rigidity),
                 [&o](const std::string & s) {
                   o.rigidity = ParseDouble("--rigidity", s);

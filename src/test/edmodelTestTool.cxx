@@ -5,6 +5,7 @@
 //   edmodelTestTool phantom IMG --size X,Y,Z --spacing X,Y,Z --origin X,Y,Z
 //                   [--direction 9 numbers, row by row] --center X,Y,Z --radii A,B,C
 //                   [--axes 9 numbers] [--inside V] [--outside V] [--pixel float|short|double]
+//                   [--noise S]   (Gaussian noise of standard deviation S, fixed seed)
 //   edmodelTestTool dicom DIR (same options as phantom, 16-bit slices)
 //   edmodelTestTool sphere MESH --center X,Y,Z --radius R [--resolution N]
 //   edmodelTestTool lines MESH          (points and lines: no triangle)
@@ -29,6 +30,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -114,8 +116,23 @@ MakePhantomImage(const std::map<std::string, std::string> & options)
   }
   const double inside = options.count("--inside") ? std::stod(options.at("--inside")) : 1.0;
   const double outside = options.count("--outside") ? std::stod(options.at("--outside")) : 0.0;
-  return Phantom(options).MakeImage<ImageType>(
+  auto image = Phantom(options).MakeImage<ImageType>(
     imageSize, imageSpacing, imageOrigin, direction, static_cast<TPixel>(inside), static_cast<TPixel>(outside));
+  const double noise = options.count("--noise") ? std::stod(options.at("--noise")) : 0.0;
+  if (noise > 0.0)
+  {
+    // A fixed seed: the same image on every run and every machine (mt19937's
+    // sequence is specified; the normal distribution's transform is the
+    // library's, the same on the one compiler CI uses).
+    std::mt19937                     generator(20261202u);
+    std::normal_distribution<double> normal(0.0, noise);
+    TPixel *                         pixel = image->GetBufferPointer();
+    for (size_t i = 0, n = image->GetPixelContainer()->Size(); i < n; ++i)
+    {
+      pixel[i] = static_cast<TPixel>(static_cast<double>(pixel[i]) + normal(generator));
+    }
+  }
+  return image;
 }
 
 template <typename TPixel>
