@@ -36,6 +36,7 @@
 #include "vtkPointData.h"
 #include "vtkPolyData.h"
 
+#include <cmath>
 #include <new>
 #include <vector>
 
@@ -88,6 +89,10 @@ vtkDeformableMesh::vtkDeformableMesh()
   this->EdgeSearchWeight = filter->GetEdgeSearchWeight();
   this->EdgeSearchDistance = filter->GetEdgeSearchDistance();
   this->IntensityTolerance = filter->GetIntensityTolerance();
+  this->EstimateBackgroundIntensity = filter->GetEstimateBackgroundIntensity() ? 1 : 0;
+  this->BackgroundUpdateInterval = static_cast<int>(filter->GetBackgroundUpdateInterval());
+  this->EstimateObjectIntensityRange = filter->GetEstimateObjectIntensityRange() ? 1 : 0;
+  this->EdgePolarity = filter->GetEdgePolarity();
   this->SetInputArrayToProcess(0, 1, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::VECTORS);
   this->SetInputArrayToProcess(1, 1, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
 }
@@ -244,6 +249,25 @@ vtkDeformableMesh::PrepareFilter(vtkInformationVector ** inputVector)
   filter->SetEdgeSearchWeight(this->EdgeSearchWeight);
   filter->SetEdgeSearchDistance(this->EdgeSearchDistance);
   filter->SetIntensityTolerance(this->IntensityTolerance);
+  filter->SetEstimateBackgroundIntensity(this->EstimateBackgroundIntensity != 0);
+  filter->SetBackgroundUpdateInterval(static_cast<unsigned int>(this->BackgroundUpdateInterval));
+  if (this->EstimateObjectIntensityRange)
+  {
+    filter->SetEstimateObjectIntensityRange(true);
+  }
+  else
+  {
+    const double lower = this->ObjectIntensityRange[0];
+    const double upper = this->ObjectIntensityRange[1];
+    if (!(lower < upper) || !std::isfinite(upper - lower))
+    {
+      vtkErrorMacro("ObjectIntensityRange must be finite with its lower bound below its upper bound, got ["
+                    << lower << ", " << upper << "].");
+      return 0;
+    }
+    filter->SetObjectIntensityRange(lower, upper, 0.1 * (upper - lower));
+  }
+  filter->SetEdgePolarity(this->EdgePolarity);
   filter->SetScaleFactor(this->ScaleFactor);
   filter->SetElasticity(this->Elasticity);
   filter->SetTangentialElasticity(this->TangentialElasticity != 0);
@@ -300,6 +324,12 @@ vtkDeformableMesh::PrintSelf(ostream & os, vtkIndent indent)
   os << indent << "EdgeSearchWeight: " << this->EdgeSearchWeight << "\n";
   os << indent << "EdgeSearchDistance: " << this->EdgeSearchDistance << "\n";
   os << indent << "IntensityTolerance: " << this->IntensityTolerance << "\n";
+  os << indent << "EstimateBackgroundIntensity: " << this->EstimateBackgroundIntensity << "\n";
+  os << indent << "BackgroundUpdateInterval: " << this->BackgroundUpdateInterval << "\n";
+  os << indent << "EstimateObjectIntensityRange: " << this->EstimateObjectIntensityRange << "\n";
+  os << indent << "ObjectIntensityRange: " << this->ObjectIntensityRange[0] << " " << this->ObjectIntensityRange[1]
+     << "\n";
+  os << indent << "EdgePolarity: " << this->EdgePolarity << "\n";
   os << indent << "MaximumStepLength: " << this->MaximumStepLength << "\n";
   os << indent << "RemeshingEdgeLength: " << this->RemeshingEdgeLength << "\n";
   os << indent << "RemeshingInterval: " << this->RemeshingInterval << "\n";

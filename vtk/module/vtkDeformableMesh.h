@@ -196,6 +196,63 @@ public:
 
   ///@{
   /**
+   * With the object's range estimated (EstimateObjectIntensityRange on), the
+   * bounds of the range follow the background sampled just outside the
+   * surface every BackgroundUpdateInterval iterations. Default: on.
+   * Meaning in full: itk::DeformableMeshFilter::SetEstimateBackgroundIntensity().
+   */
+  vtkSetMacro(EstimateBackgroundIntensity, vtkTypeBool);
+  vtkGetMacro(EstimateBackgroundIntensity, vtkTypeBool);
+  vtkBooleanMacro(EstimateBackgroundIntensity, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
+   * Iterations between two estimates of the background. At least 1;
+   * default 10. Meaning in full:
+   * itk::DeformableMeshFilter::SetBackgroundUpdateInterval().
+   */
+  vtkSetClampMacro(BackgroundUpdateInterval, int, 1, VTK_INT_MAX);
+  vtkGetMacro(BackgroundUpdateInterval, int);
+  ///@}
+
+  ///@{
+  /**
+   * On (default): the object's intensity model is estimated inside the
+   * initial surface at each reset. Off: ObjectIntensityRange is the object's
+   * range, fixed (no background estimate), with a transition width of a
+   * tenth of it. Meaning in full:
+   * itk::DeformableMeshFilter::SetEstimateObjectIntensityRange() and
+   * SetObjectIntensityRange().
+   */
+  vtkSetMacro(EstimateObjectIntensityRange, vtkTypeBool);
+  vtkGetMacro(EstimateObjectIntensityRange, vtkTypeBool);
+  vtkBooleanMacro(EstimateObjectIntensityRange, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
+   * The object's intensity range [lower, upper], in the intensity array's
+   * units, used when EstimateObjectIntensityRange is off (lower below
+   * upper, or RequestData fails). Default: [0, 1].
+   */
+  vtkSetVector2Macro(ObjectIntensityRange, double);
+  vtkGetVector2Macro(ObjectIntensityRange, double);
+  ///@}
+
+  ///@{
+  /**
+   * The edges the edge search looks for: +1 where the intensity falls
+   * outward (bright object), -1 where it rises (dark object), 0 (default)
+   * from the intensity model. Meaning in full:
+   * itk::DeformableMeshFilter::SetEdgePolarity().
+   */
+  vtkSetClampMacro(EdgePolarity, int, -1, 1);
+  vtkGetMacro(EdgePolarity, int);
+  ///@}
+
+  ///@{
+  /**
    * Bound on a vertex's displacement per iteration; 0: no bound.
    * Millimetres, at least 0; default 0.
    * Meaning in full: itk::DeformableMeshFilter::SetMaximumStepLength().
@@ -290,6 +347,11 @@ protected:
   double      EdgeSearchWeight = 0.0;
   double      EdgeSearchDistance = 2.0;
   double      IntensityTolerance = 2.2;
+  vtkTypeBool EstimateBackgroundIntensity = 1;
+  int         BackgroundUpdateInterval = 10;
+  vtkTypeBool EstimateObjectIntensityRange = 1;
+  double      ObjectIntensityRange[2] = { 0.0, 1.0 };
+  int         EdgePolarity = 0;
   double      ConvergenceTolerance = 0.0;
   int         ConvergenceWindow = 3;
   vtkTypeBool ComputeDiagnostics = 1;
