@@ -99,8 +99,18 @@ public:
     return s <= 1.0;
   }
 
-  /** Euclidean distance from p to the ellipsoid's surface (physical units),
-   * by bisection on the Lagrange multiplier of the closest-point problem. */
+  /** Euclidean distance from p to the ellipsoid's surface (physical units).
+   * In the frame of the semi-axes a_k, with z the absolute coordinates of p,
+   * the closest point is x_k = a_k^2 z_k / (t + a_k^2) for the root t of
+   * g(t) = sum (a_k z_k / (t + a_k^2))^2 - 1 above -a_min^2, found by
+   * bisection. One case has no such root: a point (inside the ellipsoid)
+   * whose coordinates along the shortest semi-axes are zero and which lies
+   * near enough to the centre that g stays below 0 down to -a_min^2. Its
+   * closest points then leave the plane of those axes: t = -a_min^2, the
+   * other coordinates as above, and the shortest axes' part of the closest
+   * point of length a_min sqrt(1 - sum over the other axes of (x_k / a_k)^2)
+   * (a point on the long axis of an elongated ellipsoid, say: its closest
+   * points lie on a ring around that axis). */
   double
   DistanceToSurface(const PointType & p) const
   {
@@ -112,7 +122,40 @@ public:
       z[k] = std::abs(y[k]);
       a2[k] = m_Radii[k] * m_Radii[k];
     }
-    // g(t) = sum (a_k z_k / (t + a_k^2))^2 - 1 decreases on (-min a^2, inf).
+    const double smallest = std::min({ a2[0], a2[1], a2[2] });
+    const auto   isShortest = [&](unsigned int k) { return a2[k] <= smallest * (1.0 + 1e-12); };
+
+    // The degenerate case: zero coordinates along the shortest semi-axes.
+    double shortestPart = 0.0;
+    double offPlane = 0.0;
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      if (isShortest(k))
+      {
+        shortestPart += z[k] * z[k];
+      }
+      else
+      {
+        const double q = m_Radii[k] * z[k] / (a2[k] - smallest);
+        offPlane += q * q;
+      }
+    }
+    if (shortestPart <= 1e-18 * smallest && offPlane < 1.0)
+    {
+      double d2 = smallest * (1.0 - offPlane);
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        if (!isShortest(k))
+        {
+          const double closest = a2[k] * z[k] / (a2[k] - smallest);
+          d2 += (closest - z[k]) * (closest - z[k]);
+        }
+      }
+      return std::sqrt(d2);
+    }
+
+    // g(t) decreases on (-a_min^2, inf), from +inf (or from g(-a_min^2) >= 0
+    // in the degenerate case's other half) to -1.
     auto g = [&](double t) {
       double s = 0.0;
       for (unsigned int k = 0; k < 3; ++k)
@@ -122,7 +165,6 @@ public:
       }
       return s - 1.0;
     };
-    const double smallest = std::min({ a2[0], a2[1], a2[2] });
     const double norm = std::sqrt(z[0] * z[0] + z[1] * z[1] + z[2] * z[2]);
     double       low = -smallest;
     double       high = std::sqrt(std::max({ a2[0], a2[1], a2[2] })) * norm + 1.0;
@@ -143,8 +185,8 @@ public:
     for (unsigned int k = 0; k < 3; ++k)
     {
       const double denominator = t + a2[k];
-      const double closest = denominator > 0.0 ? a2[k] * z[k] / denominator : m_Radii[k];
-      d2 += (z[k] - std::min(closest, m_Radii[k])) * (z[k] - std::min(closest, m_Radii[k]));
+      const double closest = denominator > 0.0 ? std::min(a2[k] * z[k] / denominator, m_Radii[k]) : 0.0;
+      d2 += (z[k] - closest) * (z[k] - closest);
     }
     return std::sqrt(d2);
   }

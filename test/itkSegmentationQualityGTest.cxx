@@ -357,6 +357,79 @@ ExpectQuality(const Result & r, double voxel, double meanTolerance, double maxim
 }
 } // namespace
 
+// The measure itself: known distances to the ellipsoid of radii (18, 14, 28),
+// including points inside on its long axis, whose closest points form a ring
+// around that axis (x = 784 z / 588 along it, the rest on the shortest axis),
+// and no distance above that to the nearest of 720 000 points of its surface.
+TEST(SegmentationQuality, EllipsoidDistanceKnownAnswers)
+{
+  PointType center;
+  center.Fill(0.0);
+  itk::EllipsoidPhantom::VectorType radii;
+  radii[0] = 18.0;
+  radii[1] = 14.0;
+  radii[2] = 28.0;
+  const itk::EllipsoidPhantom ellipsoid(center, radii);
+  const auto                  at = [](double x, double y, double z) {
+    PointType p;
+    p[0] = x;
+    p[1] = y;
+    p[2] = z;
+    return p;
+  };
+  EXPECT_NEAR(ellipsoid.DistanceToSurface(at(0, 0, 0)), 14.0, 1e-9);
+  EXPECT_NEAR(ellipsoid.DistanceToSurface(at(0, 0, 30)), 2.0, 1e-9);
+  EXPECT_NEAR(ellipsoid.DistanceToSurface(at(20, 0, 0)), 2.0, 1e-9);
+  EXPECT_NEAR(ellipsoid.DistanceToSurface(at(0, 0, -26)), 2.0, 1e-9);
+  {
+    // On the 18-axis near the centre: the ring around that axis too.
+    const double x = 324.0 * 3.0 / 128.0;
+    EXPECT_NEAR(ellipsoid.DistanceToSurface(at(3, 0, 0)),
+                std::hypot(x - 3.0, 14.0 * std::sqrt(1.0 - (x / 18.0) * (x / 18.0))),
+                1e-9);
+  }
+  for (const double zc : { 16.0, 8.0, -12.0 })
+  {
+    const double x = 784.0 * std::abs(zc) / 588.0;
+    const double ring = 14.0 * std::sqrt(1.0 - (x / 28.0) * (x / 28.0));
+    EXPECT_NEAR(ellipsoid.DistanceToSurface(at(0, 0, zc)), std::hypot(x - std::abs(zc), ring), 1e-9) << zc;
+  }
+  EXPECT_NEAR(ellipsoid.DistanceToSurface(at(0, 0, 16)), 10.5198, 1e-4);
+
+  // Against a dense sampling of the surface: never above it, within its
+  // sampling error (0.15 mm between samples) below it.
+  std::vector<std::array<double, 3>> samples;
+  for (int i = 0; i <= 600; ++i)
+  {
+    for (int j = 0; j < 1200; ++j)
+    {
+      const double theta = itk::Math::pi * i / 600.0;
+      const double phi = 2.0 * itk::Math::pi * j / 1200.0;
+      samples.push_back({ 18.0 * std::sin(theta) * std::cos(phi),
+                          14.0 * std::sin(theta) * std::sin(phi),
+                          28.0 * std::cos(theta) });
+    }
+  }
+  for (const auto & q : { std::array<double, 3>{ 0, 0, 16 },
+                          std::array<double, 3>{ 0, 5, 0 },
+                          std::array<double, 3>{ 4, 0, 0 },
+                          std::array<double, 3>{ 0, 3, -20 },
+                          std::array<double, 3>{ 2, 0, 22 },
+                          std::array<double, 3>{ 10, 8, 5 },
+                          std::array<double, 3>{ 25, -3, 7 },
+                          std::array<double, 3>{ 0, 0, 27.5 } })
+  {
+    double nearest = std::numeric_limits<double>::max();
+    for (const auto & s : samples)
+    {
+      nearest = std::min(nearest, std::hypot(s[0] - q[0], s[1] - q[1], s[2] - q[2]));
+    }
+    const double d = ellipsoid.DistanceToSurface(at(q[0], q[1], q[2]));
+    EXPECT_LE(d, nearest + 1e-9) << q[0] << " " << q[1] << " " << q[2];
+    EXPECT_GE(d, nearest - 0.05) << q[0] << " " << q[1] << " " << q[2];
+  }
+}
+
 TEST(SegmentationQuality, PlainGradientForcesDoNotReachThePoles)
 {
   // The reason for the balloon and GVF: without them the poles stay behind.
