@@ -22,8 +22,10 @@
 #include "edmTestUtilities.h"
 #include "gtest/gtest.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 namespace
@@ -199,4 +201,96 @@ TEST(ExternalForceImageFilter, ProgressRisesToOneWithGradientVectorFlow)
     EXPECT_GE(progress[k], progress[k - 1]) << "report " << k;
   }
   EXPECT_FLOAT_EQ(progress.back(), 1.0f);
+}
+
+// Issue 17 (2-D contours): the force field of a 2-D image, in physical
+// space. A disk of radius 10 mm on a rotated grid of 0.5 x 0.8 mm pixels:
+// 1.5 mm inside its edge the force points outward, 1.5 mm outside inward,
+// radially; the normalised field peaks at 1. With gradient vector flow the
+// field also reaches the disk's interior 6 mm from the edge (the plain
+// gradient of a 1 mm Gaussian is below a thousandth there), still outward.
+TEST(ExternalForceImageFilter, TwoDimensionalImageInPhysicalSpace)
+{
+  using Image2D = itk::Image<float, 2>;
+  using Force2D = itk::Image<itk::CovariantVector<float, 2>, 2>;
+  Image2D::SizeType size;
+  size[0] = 64;
+  size[1] = 40;
+  Image2D::SpacingType spacing;
+  spacing[0] = 0.5;
+  spacing[1] = 0.8;
+  Image2D::PointType origin;
+  origin[0] = -3.0;
+  origin[1] = 5.0;
+  Image2D::DirectionType direction;
+  const double           angle = 0.35;
+  direction(0, 0) = std::cos(angle);
+  direction(0, 1) = -std::sin(angle);
+  direction(1, 0) = std::sin(angle);
+  direction(1, 1) = std::cos(angle);
+  auto image = Image2D::New();
+  image->SetRegions(size);
+  image->SetSpacing(spacing);
+  image->SetOrigin(origin);
+  image->SetDirection(direction);
+  image->Allocate();
+  itk::ContinuousIndex<double, 2> middle;
+  middle[0] = 31.5;
+  middle[1] = 19.5;
+  Image2D::PointType center;
+  image->TransformContinuousIndexToPhysicalPoint(middle, center);
+  const double radius = 10.0;
+  for (itk::ImageRegionIteratorWithIndex<Image2D> it(image, image->GetBufferedRegion()); !it.IsAtEnd(); ++it)
+  {
+    Image2D::PointType p;
+    image->TransformIndexToPhysicalPoint(it.GetIndex(), p);
+    it.Set(p.EuclideanDistanceTo(center) <= radius ? 200.0f : 20.0f);
+  }
+
+  using FilterType = itk::ExternalForceImageFilter<Image2D, Force2D>;
+  for (const bool flow : { false, true })
+  {
+    auto filter = FilterType::New();
+    filter->SetInput(image);
+    filter->SetSigma(1.0);
+    filter->SetUseGradientVectorFlow(flow);
+    filter->Update();
+    const Force2D * field = filter->GetOutput();
+    EXPECT_EQ(field->GetDirection(), direction);
+    double largest = 0.0;
+    for (itk::ImageRegionConstIterator<Force2D> it(field, field->GetBufferedRegion()); !it.IsAtEnd(); ++it)
+    {
+      largest = std::max(largest, static_cast<double>(it.Get().GetNorm()));
+    }
+    EXPECT_NEAR(largest, 1.0, 1e-6);
+
+    const auto forceAt = [&](double angleOnCircle, double distanceFromCenter) {
+      Image2D::PointType p;
+      p[0] = center[0] + distanceFromCenter * std::cos(angleOnCircle);
+      p[1] = center[1] + distanceFromCenter * std::sin(angleOnCircle);
+      Force2D::IndexType index;
+      EXPECT_TRUE(field->TransformPhysicalPointToIndex(p, index));
+      const auto f = field->GetPixel(index);
+      return std::make_pair(f[0] * std::cos(angleOnCircle) + f[1] * std::sin(angleOnCircle),
+                            static_cast<double>(f.GetNorm()));
+    };
+    for (const double a : { 0.0, 1.1, 2.5, 4.0, 5.3 })
+    {
+      const auto inside = forceAt(a, radius - 1.5);
+      const auto outside = forceAt(a, radius + 1.5);
+      EXPECT_GT(inside.first, 0.1) << "outward inside, angle " << a << (flow ? ", GVF" : "");
+      EXPECT_LT(outside.first, -0.1) << "inward outside, angle " << a << (flow ? ", GVF" : "");
+      EXPECT_GT(inside.first, 0.8 * inside.second) << "radial, angle " << a;
+      const auto deep = forceAt(a, radius - 6.0);
+      if (flow)
+      {
+        EXPECT_GT(deep.first, 0.8 * deep.second) << "GVF reaches 6 mm inside, outward, angle " << a;
+        EXPECT_GT(deep.second, 1e-3) << "angle " << a;
+      }
+      else
+      {
+        EXPECT_LT(deep.second, 1e-3) << "angle " << a;
+      }
+    }
+  }
 }

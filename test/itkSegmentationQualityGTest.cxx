@@ -411,9 +411,8 @@ TEST(SegmentationQuality, EllipsoidDistanceKnownAnswers)
     {
       const double theta = itk::Math::pi * i / 600.0;
       const double phi = 2.0 * itk::Math::pi * j / 1200.0;
-      samples.push_back({ 18.0 * std::sin(theta) * std::cos(phi),
-                          14.0 * std::sin(theta) * std::sin(phi),
-                          28.0 * std::cos(theta) });
+      samples.push_back(
+        { 18.0 * std::sin(theta) * std::cos(phi), 14.0 * std::sin(theta) * std::sin(phi), 28.0 * std::cos(theta) });
     }
   }
   for (const auto & q : { std::array<double, 3>{ 0, 0, 16 },
@@ -466,7 +465,7 @@ TEST(SegmentationQuality, SameParametersGiveTheSameSurfaceFrom258To65538Vertices
     const auto   forces = seed.Forces(capture);
     double       smallest = std::numeric_limits<double>::max();
     double       largest = 0.0;
-    const char * name = capture == Capture::Balloon            ? "balloon"
+    const char * name = capture == Capture::Balloon              ? "balloon"
                         : capture == Capture::GradientVectorFlow ? "gradient vector flow"
                                                                  : "region force";
     for (unsigned int resolution = 3; resolution <= 7; ++resolution)

@@ -116,7 +116,7 @@ MakePhantomImage(const std::map<std::string, std::string> & options)
   }
   const double inside = options.count("--inside") ? std::stod(options.at("--inside")) : 1.0;
   const double outside = options.count("--outside") ? std::stod(options.at("--outside")) : 0.0;
-  auto image = Phantom(options).MakeImage<ImageType>(
+  auto         image = Phantom(options).MakeImage<ImageType>(
     imageSize, imageSpacing, imageOrigin, direction, static_cast<TPixel>(inside), static_cast<TPixel>(outside));
   const double noise = options.count("--noise") ? std::stod(options.at("--noise")) : 0.0;
   if (noise > 0.0)
