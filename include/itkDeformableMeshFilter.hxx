@@ -507,6 +507,7 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
     std::vector<IndexType32>().swap(m_Triangles);
   }
   m_NumberOfRemeshings = 0;
+  m_Remesher.ForgetTable();
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
   // The kernels load 4 doubles from a point's 3 coordinates: both arrays
   // of coordinates, swapped at each step, end with a guard value.
@@ -972,6 +973,17 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
   m_Remesher.SetTargetEdgeLength(m_RemeshingEdgeLength);
   m_Remesher.SetMultiThreader(this->GetMultiThreader(), this->GetNumberOfWorkUnits());
   m_Remesher.Remesh(x, numberOfPoints, m_Triangles);
+  if (!m_Remesher.GetTopologyChanged() && x.size() == 3 * numberOfPoints)
+  {
+    // Only positions moved (relaxation): the numbering, the cells, the
+    // topology and the per-vertex state stay.
+    x.push_back(0.0);
+    ++m_NumberOfRemeshings;
+    m_NumberOfCollisionsPrevented = 0;
+    m_NumberOfConstrainedVertices = 0;
+    m_Collision.Invalidate();
+    return;
+  }
   const std::vector<IndexType32> & parents = m_Remesher.Parents();
   const SizeValueType              newNumberOfPoints = parents.size();
   if (newNumberOfPoints >= std::numeric_limits<IndexType32>::max())
