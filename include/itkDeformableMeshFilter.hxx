@@ -939,7 +939,7 @@ DeformableMeshFilter<TMesh, TForceImage>::RenumberForLocality(std::vector<IndexT
     return;
   }
   std::vector<double> &          x = this->GetCoordinates();
-  const std::vector<IndexType32> order = DeformableMeshRemesher::LocalityOrder(x.data(), numberOfPoints);
+  const std::vector<IndexType32> order = DeformableMeshRemesher::BreadthFirstOrder(x.data(), numberOfPoints, edges);
   std::vector<IndexType32>       rank(numberOfPoints);
   std::vector<double>            permuted(3 * numberOfPoints);
   for (SizeValueType k = 0; k < numberOfPoints; ++k)

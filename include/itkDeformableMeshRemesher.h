@@ -195,6 +195,15 @@ public:
   static std::vector<IndexType>
   LocalityOrder(const double * coordinates, std::size_t numberOfPoints);
 
+  /** A renumbering for locality that follows the surface: a breadth-first
+   * walk over the \a edges ((min << 32 | max) of their end-points), from
+   * the point first in LocalityOrder() of each connected part. The points
+   * then come in rings around the start, so that the neighbours of a point
+   * lie in the ring before, its own and the ring after: three streams that
+   * the step reads in order. order[k] is the point that takes number k. */
+  static std::vector<IndexType>
+  BreadthFirstOrder(const double * coordinates, std::size_t numberOfPoints, const std::vector<uint64_t> & edges);
+
   /** A locality measure of a numbering: the fraction of the edges of the
    * triangles whose end-points are numbered more than \a window apart. */
   static double
@@ -1433,6 +1442,62 @@ DeformableMeshRemesher::LocalityOrder(const double * coordinates, std::size_t nu
   std::vector<IndexType> order(numberOfPoints);
   std::iota(order.begin(), order.end(), IndexType{ 0 });
   std::stable_sort(order.begin(), order.end(), [&keys](IndexType a, IndexType b) { return keys[a] < keys[b]; });
+  return order;
+}
+
+inline std::vector<DeformableMeshRemesher::IndexType>
+DeformableMeshRemesher::BreadthFirstOrder(const double *                coordinates,
+                                          std::size_t                   numberOfPoints,
+                                          const std::vector<uint64_t> & edges)
+{
+  std::vector<IndexType> offsets(numberOfPoints + 1, 0);
+  for (const uint64_t e : edges)
+  {
+    ++offsets[(e >> 32) + 1];
+    ++offsets[(e & 0xffffffffULL) + 1];
+  }
+  for (std::size_t i = 0; i < numberOfPoints; ++i)
+  {
+    offsets[i + 1] += offsets[i];
+  }
+  std::vector<IndexType> neighbours(offsets[numberOfPoints]);
+  {
+    std::vector<IndexType> fill(offsets.begin(), offsets.end() - 1);
+    for (const uint64_t e : edges)
+    {
+      const auto a = static_cast<IndexType>(e >> 32);
+      const auto b = static_cast<IndexType>(e & 0xffffffffULL);
+      neighbours[fill[a]++] = b;
+      neighbours[fill[b]++] = a;
+    }
+  }
+  const std::vector<IndexType> starts = LocalityOrder(coordinates, numberOfPoints);
+  std::vector<uint8_t>         visited(numberOfPoints, 0);
+  std::vector<IndexType>       order;
+  order.reserve(numberOfPoints);
+  for (const IndexType start : starts)
+  {
+    if (visited[start])
+    {
+      continue;
+    }
+    visited[start] = 1;
+    std::size_t head = order.size();
+    order.push_back(start);
+    while (head < order.size())
+    {
+      const IndexType v = order[head++];
+      for (IndexType k = offsets[v]; k < offsets[v + 1]; ++k)
+      {
+        const IndexType w = neighbours[k];
+        if (!visited[w])
+        {
+          visited[w] = 1;
+          order.push_back(w);
+        }
+      }
+    }
+  }
   return order;
 }
 
