@@ -180,6 +180,14 @@ public:
     m_TableValid = false;
   }
 
+  /** The neighbours of vertex \a v of the last Remesh()'s output in the
+   * order of its fan of triangles (oriented as the triangles). Returns 1 for
+   * a closed fan, 2 for an open one (a boundary vertex: the first and last
+   * neighbours lie on the boundary), 0 for a frozen vertex (its triangles do
+   * not form one fan; \a neighbours then is not the ring). */
+  int
+  OutputRing(IndexType v, std::vector<IndexType> & neighbours) const;
+
   /** For each vertex of the last Remesh()'s output, the input vertex it
    * comes from. */
   const std::vector<IndexType> &
@@ -312,6 +320,16 @@ enum : uint8_t
   RemesherFrozen = 2,
   RemesherRemoved = 3
 };
+
+inline int
+DeformableMeshRemesher::OutputRing(IndexType v, std::vector<IndexType> & neighbours) const
+{
+  if (!m_TableValid || v >= m_State.size() || !this->Ring(v, neighbours, nullptr))
+  {
+    return 0;
+  }
+  return m_State[v] == RemesherBoundary ? 2 : 1;
+}
 
 inline double
 DeformableMeshRemesher::Length2(IndexType a, IndexType b) const
