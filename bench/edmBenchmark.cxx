@@ -75,6 +75,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -338,6 +339,28 @@ StepsPerUpdate(int64_t vertices)
 // on a shared machine).
 std::map<std::string, double> summaryRates;
 std::map<std::string, double> summaryBestRates;
+std::map<std::string, double> summaryCPUTimes; // CPU ns per vertex-iteration, the last run
+
+/** CPU time of the process (all threads), seconds: on a shared machine the
+ * CPU time per vertex-iteration depends less on the other work than the
+ * wall-clock rate does. */
+double
+ProcessCPUSeconds()
+{
+  timespec now{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
+  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
+}
+
+/** The counter of CPU nanoseconds (all threads) per vertex-iteration. */
+void
+SetCPUTimeCounter(benchmark::State & state, double cpuSeconds, double vertexIterations)
+{
+  if (vertexIterations > 0.0)
+  {
+    state.counters["cpu_ns/vertex_it"] = 1e9 * cpuSeconds / vertexIterations;
+  }
+}
 
 /** Largest value over the repetitions: for a rate, the best repetition. */
 double
@@ -410,13 +433,15 @@ RunDeformableMesh(benchmark::State & state,
   model->SetNumberOfIterations(1);
   model->Update(); // Reset(): topology and state, outside the timing.
 
-  int64_t stepsRun = 0;
+  int64_t      stepsRun = 0;
+  const double cpuStart = ProcessCPUSeconds();
   for (auto _ : state)
   {
     model->SetNumberOfIterations(model->GetCurrentIteration() + steps);
     model->Update();
     stepsRun += steps;
   }
+  SetCPUTimeCounter(state, ProcessCPUSeconds() - cpuStart, static_cast<double>(vertices * stepsRun));
   state.counters["vertices"] = static_cast<double>(vertices);
   state.counters["vertex_it/s"] =
     benchmark::Counter(static_cast<double>(vertices * stepsRun), benchmark::Counter::kIsRate);
@@ -545,7 +570,8 @@ BM_EDM_Remeshing(benchmark::State & state)
   model->SetNumberOfIterations(1);
   model->Update();
 
-  int64_t vertexIterations = 0;
+  int64_t      vertexIterations = 0;
+  const double cpuStart = ProcessCPUSeconds();
   for (auto _ : state)
   {
     const auto vertices = static_cast<int64_t>(model->GetOutput()->GetNumberOfPoints());
@@ -553,6 +579,7 @@ BM_EDM_Remeshing(benchmark::State & state)
     model->Update();
     vertexIterations += steps * (vertices + static_cast<int64_t>(model->GetOutput()->GetNumberOfPoints())) / 2;
   }
+  SetCPUTimeCounter(state, ProcessCPUSeconds() - cpuStart, static_cast<double>(vertexIterations));
   state.counters["vertices"] = static_cast<double>(model->GetOutput()->GetNumberOfPoints());
   state.counters["remeshings"] = static_cast<double>(model->GetNumberOfRemeshings());
   state.counters["vertex_it/s"] =
@@ -589,13 +616,15 @@ BM_EDM_RegularSphereSource(benchmark::State & state)
   model->SetNumberOfIterations(1);
   model->Update();
 
-  int64_t stepsRun = 0;
+  int64_t      stepsRun = 0;
+  const double cpuStart = ProcessCPUSeconds();
   for (auto _ : state)
   {
     model->SetNumberOfIterations(model->GetCurrentIteration() + steps);
     model->Update();
     stepsRun += steps;
   }
+  SetCPUTimeCounter(state, ProcessCPUSeconds() - cpuStart, static_cast<double>(vertices * stepsRun));
   state.counters["vertices"] = static_cast<double>(vertices);
   state.counters["vertex_it/s"] =
     benchmark::Counter(static_cast<double>(vertices * stepsRun), benchmark::Counter::kIsRate);
@@ -1024,6 +1053,11 @@ public:
   {
     for (const Run & run : runs)
     {
+      const auto cpu = run.counters.find("cpu_ns/vertex_it");
+      if (cpu != run.counters.end() && !run.error_occurred && run.run_type == Run::RT_Iteration)
+      {
+        summaryCPUTimes[run.run_name.str()] = cpu->second.value;
+      }
       for (const char * counter : { "vertex_it/s", "voxel/s" })
       {
         const auto it = run.counters.find(counter);
@@ -1055,6 +1089,13 @@ Rate(const std::string & name)
   }
   const auto it = summaryRates.find(name);
   return it == summaryRates.end() ? 0.0 : it->second;
+}
+
+double
+CPUTime(const std::string & name)
+{
+  const auto it = summaryCPUTimes.find(name);
+  return it == summaryCPUTimes.end() ? 0.0 : it->second;
 }
 
 void
@@ -1123,16 +1164,33 @@ PrintSummary()
     if (remesh100k + remesh1M > 0.0)
     {
       std::printf("remeshing every 10 iterations, 2 threads: 100000 vertices %.2f M, 1000000 vertices %.2f M "
-                  "vertex-iterations/s (issue 15 target: 25 M)\n",
+                  "vertex-iterations/s (issue 15 target: 25 M); CPU time per vertex-iteration %.0f ns and %.0f ns\n",
                   remesh100k * 1e-6,
-                  remesh1M * 1e-6);
+                  remesh1M * 1e-6,
+                  CPUTime("BM_EDM_Remeshing/vertices:100000/real_time"),
+                  CPUTime("BM_EDM_Remeshing/vertices:1000000/real_time"));
+    }
+    const double collision100k = Rate("BM_EDM_SelfIntersection/vertices:100000/threads:2/real_time");
+    const double collision1M = Rate("BM_EDM_SelfIntersection/vertices:1000000/threads:2/real_time");
+    if (collision100k + collision1M > 0.0)
+    {
+      std::printf("collision test every iteration, 2 threads: 100000 vertices %.2f M, 1000000 vertices %.2f M "
+                  "vertex-iterations/s (issue 15 target: 25 M); CPU time per vertex-iteration %.0f ns and %.0f ns\n",
+                  collision100k * 1e-6,
+                  collision1M * 1e-6,
+                  CPUTime("BM_EDM_SelfIntersection/vertices:100000/threads:2/real_time"),
+                  CPUTime("BM_EDM_SelfIntersection/vertices:1000000/threads:2/real_time"));
     }
     if (renumbered + asInput > 0.0)
     {
       std::printf("RegularSphereMeshSource, 262146 vertices, 2 threads: renumbered %.2f M, input numbering %.2f M "
-                  "vertex-iterations/s (issue 15 target: 50 M)\n",
+                  "vertex-iterations/s (issue 15 target: 50 M); CPU time per vertex-iteration %.1f ns and %.1f ns "
+                  "(geodesic sphere, 100000 vertices, 2 threads: %.1f ns)\n",
                   renumbered * 1e-6,
-                  asInput * 1e-6);
+                  asInput * 1e-6,
+                  CPUTime("BM_EDM_RegularSphereSource/renumber:1/real_time"),
+                  CPUTime("BM_EDM_RegularSphereSource/renumber:0/real_time"),
+                  CPUTime("BM_EDM_DeformableMesh/vertices:100000/threads:2/real_time"));
     }
   }
   for (const char * size : { "128", "256" })

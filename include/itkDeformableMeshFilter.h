@@ -563,6 +563,17 @@ private:
   void
   BuildTopology(const std::vector<IndexType32> & triangles, std::vector<uint64_t> & edges, bool edgesUnique = false);
 
+  /** After a remeshing: the step's tables from the remesher's fans, the
+   * same as BuildTopology() gives, without sorting each vertex's pairs;
+   * false (nothing changed) when a vertex has no single fan. */
+  bool
+  BuildTopologyFromRemesher();
+
+  /** The end of BuildTopology(): orientation sign, number of triangles,
+   * valence order. */
+  void
+  FinishTopology(const std::vector<IndexType32> & triangles);
+
   /** Renumbers the cached points for locality when their numbering is not
    * local; relabels \a triangles and \a edges. */
   void

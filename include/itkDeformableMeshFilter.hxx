@@ -421,6 +421,84 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology(const std::vector<IndexT
     }
   }
 
+  this->FinishTopology(triangles);
+}
+
+template <typename TMesh, typename TForceImage>
+bool
+DeformableMeshFilter<TMesh, TForceImage>::BuildTopologyFromRemesher()
+{
+  using namespace DeformableMeshFilterDetail;
+  // Each vertex's fan from the remesher's corner table: a closed ring from
+  // its smallest neighbour, an open one from its boundary end, as
+  // BuildTopology() orders them.
+  const SizeValueType      numberOfPoints = this->GetNumberOfCachedPoints();
+  constexpr SizeValueType  block = 16384;
+  const SizeValueType      numberOfBlocks = (numberOfPoints + block - 1) / block;
+  std::vector<IndexType32> offsets(numberOfPoints + 1, 0);
+  std::vector<uint8_t>     kinds(numberOfPoints, GeneralVertex);
+  std::vector<uint8_t>     blockFans(numberOfBlocks, 1);
+  MultiThreaderBase *      threader = this->GetMultiThreader();
+  threader->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
+  threader->ParallelizeArray(
+    0,
+    numberOfBlocks,
+    [&](SizeValueType b) {
+      std::vector<IndexType32> ring;
+      for (SizeValueType i = b * block; i < std::min(numberOfPoints, (b + 1) * block); ++i)
+      {
+        const int kind = m_Remesher.OutputRing(static_cast<IndexType32>(i), ring);
+        if (kind == 0 || ring.size() < 2)
+        {
+          blockFans[b] = 0;
+          return;
+        }
+        offsets[i + 1] = static_cast<IndexType32>(ring.size());
+        kinds[i] = kind == 1 ? ClosedRing : OpenRing;
+      }
+    },
+    nullptr);
+  if (std::find(blockFans.begin(), blockFans.end(), 0) != blockFans.end())
+  {
+    return false;
+  }
+  for (SizeValueType i = 0; i < numberOfPoints; ++i)
+  {
+    offsets[i + 1] += offsets[i];
+  }
+  m_Neighbours.resize(offsets[numberOfPoints]);
+  threader->ParallelizeArray(
+    0,
+    numberOfBlocks,
+    [&](SizeValueType b) {
+      std::vector<IndexType32> ring;
+      for (SizeValueType i = b * block; i < std::min(numberOfPoints, (b + 1) * block); ++i)
+      {
+        m_Remesher.OutputRing(static_cast<IndexType32>(i), ring);
+        if (kinds[i] == ClosedRing)
+        {
+          std::rotate(ring.begin(), std::min_element(ring.begin(), ring.end()), ring.end());
+        }
+        std::copy(ring.begin(), ring.end(), m_Neighbours.begin() + offsets[i]);
+      }
+    },
+    nullptr);
+  m_NeighbourOffsets.swap(offsets);
+  m_RingKinds.swap(kinds);
+  m_GeneralVertices.clear();
+  m_GeneralPairOffsets.assign(1, 0);
+  m_GeneralPairs.clear();
+  this->FinishTopology(m_Triangles);
+  return true;
+}
+
+template <typename TMesh, typename TForceImage>
+void
+DeformableMeshFilter<TMesh, TForceImage>::FinishTopology(const std::vector<IndexType32> & triangles)
+{
+  using namespace DeformableMeshFilterDetail;
+  const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
+  const SizeValueType numberOfTriangles = triangles.size() / 3;
   // Outward orientation from the signed volume enclosed by the triangles.
   const double * x = this->GetCoordinates().data();
   double         volume = 0.0;
@@ -507,6 +585,7 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
     std::vector<IndexType32>().swap(m_Triangles);
   }
   m_NumberOfRemeshings = 0;
+  m_Remesher.ForgetTable();
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
   // The kernels load 4 doubles from a point's 3 coordinates: both arrays
   // of coordinates, swapped at each step, end with a guard value.
@@ -938,7 +1017,7 @@ DeformableMeshFilter<TMesh, TForceImage>::RenumberForLocality(std::vector<IndexT
     return;
   }
   std::vector<double> &          x = this->GetCoordinates();
-  const std::vector<IndexType32> order = DeformableMeshRemesher::LocalityOrder(x.data(), numberOfPoints);
+  const std::vector<IndexType32> order = DeformableMeshRemesher::BreadthFirstOrder(x.data(), numberOfPoints, edges);
   std::vector<IndexType32>       rank(numberOfPoints);
   std::vector<double>            permuted(3 * numberOfPoints);
   for (SizeValueType k = 0; k < numberOfPoints; ++k)
@@ -972,6 +1051,17 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
   m_Remesher.SetTargetEdgeLength(m_RemeshingEdgeLength);
   m_Remesher.SetMultiThreader(this->GetMultiThreader(), this->GetNumberOfWorkUnits());
   m_Remesher.Remesh(x, numberOfPoints, m_Triangles);
+  if (!m_Remesher.GetTopologyChanged() && x.size() == 3 * numberOfPoints)
+  {
+    // Only positions moved (relaxation): the numbering, the cells, the
+    // topology and the per-vertex state stay.
+    x.push_back(0.0);
+    ++m_NumberOfRemeshings;
+    m_NumberOfCollisionsPrevented = 0;
+    m_NumberOfConstrainedVertices = 0;
+    m_Collision.Invalidate();
+    return;
+  }
   const std::vector<IndexType32> & parents = m_Remesher.Parents();
   const SizeValueType              newNumberOfPoints = parents.size();
   if (newNumberOfPoints >= std::numeric_limits<IndexType32>::max())
@@ -1005,9 +1095,12 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
   std::vector<float>().swap(m_EdgeHits);
 
   this->SetCachedTriangles(newNumberOfPoints, m_Triangles);
-  std::vector<uint64_t> edges;
-  const bool            unique = m_Remesher.Edges(edges);
-  this->BuildTopology(m_Triangles, edges, unique);
+  if (!this->BuildTopologyFromRemesher())
+  {
+    std::vector<uint64_t> edges;
+    const bool            unique = m_Remesher.Edges(edges);
+    this->BuildTopology(m_Triangles, edges, unique);
+  }
   ++m_NumberOfRemeshings;
   // The collision test's tables for the new mesh (no check: see
   // ResetCollision()).

@@ -158,11 +158,35 @@ public:
    * end-points, in no particular order; returns true when each edge is
    * listed once (false when frozen non-manifold edges may repeat). */
   bool
-  Edges(std::vector<uint64_t> & edges) const
+  Edges(std::vector<uint64_t> & edges) const;
+
+  /** Whether the last Remesh() changed the connectivity (a split, collapse
+   * or flip). When it did not, the points and triangles kept their numbers
+   * and only positions moved (relaxation). */
+  bool
+  GetTopologyChanged() const
   {
-    edges = m_Edges;
-    return m_EdgesUnique;
+    return m_Statistics.splits + m_Statistics.collapses + m_Statistics.flips > 0;
   }
+
+  /** Forgets the corner table kept from the last Remesh(): the next one
+   * builds it from its input. Remesh() keeps the table of its output and
+   * reuses it when it is given that output again (the next remeshing of a
+   * mesh that only moved), which saves building it; the result is the same
+   * either way. */
+  void
+  ForgetTable()
+  {
+    m_TableValid = false;
+  }
+
+  /** The neighbours of vertex \a v of the last Remesh()'s output in the
+   * order of its fan of triangles (oriented as the triangles). Returns 1 for
+   * a closed fan, 2 for an open one (a boundary vertex: the first and last
+   * neighbours lie on the boundary), 0 for a frozen vertex (its triangles do
+   * not form one fan; \a neighbours then is not the ring). */
+  int
+  OutputRing(IndexType v, std::vector<IndexType> & neighbours) const;
 
   /** For each vertex of the last Remesh()'s output, the input vertex it
    * comes from. */
@@ -178,6 +202,15 @@ public:
    * box, so that neighbours on a surface mostly get close numbers. */
   static std::vector<IndexType>
   LocalityOrder(const double * coordinates, std::size_t numberOfPoints);
+
+  /** A renumbering for locality that follows the surface: a breadth-first
+   * walk over the \a edges ((min << 32 | max) of their end-points), from
+   * the point first in LocalityOrder() of each connected part. The points
+   * then come in rings around the start, so that the neighbours of a point
+   * lie in the ring before, its own and the ring after: three streams that
+   * the step reads in order. order[k] is the point that takes number k. */
+  static std::vector<IndexType>
+  BreadthFirstOrder(const double * coordinates, std::size_t numberOfPoints, const std::vector<uint64_t> & edges);
 
   /** A locality measure of a numbering: the fraction of the edges of the
    * triangles whose end-points are numbered more than \a window apart. */
@@ -215,8 +248,11 @@ private:
   void
   TriangleNormal(const double * a, const double * b, const double * c, double n[3]) const;
 
+  /** Splits the long edges: those of the whole mesh when \a all, else those
+   * of the triangles the splits of the last pass touched (only they can be
+   * long after a pass that split every long edge). */
   bool
-  SplitPass();
+  SplitPass(bool all);
   void
   Split(IndexType c);
   void
@@ -262,8 +298,10 @@ private:
   std::vector<uint8_t>   m_State; // 0 free, 1 boundary, 2 frozen, 3 removed
   std::vector<double>    m_X;
   std::vector<IndexType> m_Parents;
-  std::vector<uint64_t>  m_Edges;
-  bool                   m_EdgesUnique{ true };
+  bool                   m_TableValid{ false };
+  std::vector<IndexType> m_SplitTouched; // triangles the splits of a pass changed or made
+  std::vector<IndexType> m_NewIndex;     // scratch of Compact()
+  std::vector<IndexType> m_NewCorner;
   std::size_t            m_InputPoints{ 0 };
   Statistics             m_Statistics;
   double                 m_Min2{ 0.0 };
@@ -282,6 +320,16 @@ enum : uint8_t
   RemesherFrozen = 2,
   RemesherRemoved = 3
 };
+
+inline int
+DeformableMeshRemesher::OutputRing(IndexType v, std::vector<IndexType> & neighbours) const
+{
+  if (!m_TableValid || v >= m_State.size() || !this->Ring(v, neighbours, nullptr))
+  {
+    return 0;
+  }
+  return m_State[v] == RemesherBoundary ? 2 : 1;
+}
 
 inline double
 DeformableMeshRemesher::Length2(IndexType a, IndexType b) const
@@ -473,10 +521,12 @@ DeformableMeshRemesher::Ring(IndexType v, std::vector<IndexType> & neighbours, s
   {
     return false;
   }
-  // Back to the first corner of the fan: reverse swing c -> Next(O[c]).
+  // Back to the first corner of the fan: reverse swing c -> Next(O[c]). The
+  // fan of a free vertex is closed (it has no boundary edge): the walk
+  // would come back to the start, so it is skipped.
   IndexType   c = start;
   std::size_t guard = 0;
-  while (true)
+  while (m_State[v] != RemesherFree)
   {
     const int64_t o = m_O[c];
     if (o == NonManifold)
@@ -608,41 +658,73 @@ DeformableMeshRemesher::Split(IndexType c)
     m_O[c] = Boundary;
     m_O[t2] = Boundary;
   }
+  m_SplitTouched.push_back(c / 3);
+  m_SplitTouched.push_back(t2 / 3);
+  if (o >= 0)
+  {
+    m_SplitTouched.push_back(static_cast<IndexType>(o) / 3);
+    m_SplitTouched.push_back(t2 / 3 + 1);
+  }
   ++m_Statistics.splits;
 }
 
 inline bool
-DeformableMeshRemesher::SplitPass()
+DeformableMeshRemesher::SplitPass(bool all)
 {
   // The long edges of the mesh as it is, longest first: splitting a long
   // edge before the shorter ones around it avoids fans of thin triangles.
+  // Each edge is listed from its corner of lower index (or its only one).
   std::vector<std::pair<double, IndexType>> candidates;
-  for (IndexType c = 0; c < m_V.size(); ++c)
-  {
+  const auto                                consider = [&](IndexType c) {
     if (m_V[c] == Invalid)
     {
-      continue;
+      return;
     }
     const int64_t o = m_O[c];
-    if (o == NonManifold || (o >= 0 && o < static_cast<int64_t>(c)))
+    if (o == NonManifold)
     {
-      continue;
+      return;
     }
     const IndexType a = m_V[c];
     const IndexType b = m_V[Next(c)];
     if (m_State[a] == RemesherFrozen || m_State[b] == RemesherFrozen)
     {
-      continue;
+      return;
     }
     const double length2 = this->Length2(a, b);
     if (length2 > m_Max2)
     {
-      candidates.emplace_back(length2, c);
+      candidates.emplace_back(length2, o >= 0 && o < static_cast<int64_t>(c) ? static_cast<IndexType>(o) : c);
+    }
+  };
+  if (all)
+  {
+    for (IndexType c = 0; c < m_V.size(); ++c)
+    {
+      const int64_t o = m_O[c];
+      if (o < 0 || o > static_cast<int64_t>(c))
+      {
+        consider(c);
+      }
     }
   }
+  else
+  {
+    std::sort(m_SplitTouched.begin(), m_SplitTouched.end());
+    m_SplitTouched.erase(std::unique(m_SplitTouched.begin(), m_SplitTouched.end()), m_SplitTouched.end());
+    for (const IndexType t : m_SplitTouched)
+    {
+      for (IndexType c = 3 * t; c < 3 * t + 3; ++c)
+      {
+        consider(c);
+      }
+    }
+  }
+  m_SplitTouched.clear();
   std::sort(candidates.begin(), candidates.end(), [](const auto & p, const auto & q) {
     return p.first > q.first || (p.first == q.first && p.second < q.second);
   });
+  candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
   for (const auto & candidate : candidates)
   {
     // A split changes the edges of the corners of its triangles: check again.
@@ -1130,72 +1212,141 @@ DeformableMeshRemesher::LengthenPass()
 inline void
 DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<IndexType> & triangles)
 {
-  // Order: the input vertices kept, in order, each followed by the vertices
-  // split from its edges (a counting sort on the input ancestor).
-  const std::size_t      numberOfPoints = m_State.size();
-  std::vector<IndexType> root(numberOfPoints);
-  for (std::size_t i = 0; i < numberOfPoints; ++i)
+  const std::size_t numberOfPoints = m_State.size();
+  const std::size_t numberOfCorners = m_V.size();
+  const bool        removed =
+    m_Statistics.collapses > 0 || std::find(m_State.begin(), m_State.end(), RemesherRemoved) != m_State.end();
+  if (numberOfPoints == m_InputPoints && !removed)
   {
-    root[i] = i < m_InputPoints ? static_cast<IndexType>(i) : root[m_Parents[i]];
-  }
-  std::vector<IndexType> start(m_InputPoints + 1, 0);
-  for (std::size_t i = 0; i < numberOfPoints; ++i)
-  {
-    if (m_State[i] != RemesherRemoved)
+    // No point added or removed: the numbering and the triangles' order stay
+    // (flips changed some corners).
+    coordinates.assign(m_X.begin(), m_X.end());
+    if (m_Statistics.flips > 0)
     {
-      ++start[root[i] + 1];
+      triangles.assign(m_V.begin(), m_V.end());
     }
   }
-  for (std::size_t i = 0; i < m_InputPoints; ++i)
+  else
   {
-    start[i + 1] += start[i];
-  }
-  const IndexType        kept = start[m_InputPoints];
-  std::vector<IndexType> newIndex(numberOfPoints, Invalid);
-  std::vector<IndexType> parents(kept);
-  coordinates.resize(3 * static_cast<std::size_t>(kept));
-  for (std::size_t i = 0; i < numberOfPoints; ++i)
-  {
-    if (m_State[i] != RemesherRemoved)
+    // Order: the input vertices kept, in order, each followed by the vertices
+    // split from its edges (a counting sort on the input ancestor).
+    std::vector<IndexType> root(numberOfPoints);
+    for (std::size_t i = 0; i < numberOfPoints; ++i)
     {
-      const IndexType k = start[root[i]]++;
-      newIndex[i] = k;
-      parents[k] = i < m_InputPoints ? static_cast<IndexType>(i) : m_Parents[i];
-      std::copy(m_X.data() + 3 * i, m_X.data() + 3 * i + 3, coordinates.data() + 3 * static_cast<std::size_t>(k));
+      root[i] = i < m_InputPoints ? static_cast<IndexType>(i) : root[m_Parents[i]];
     }
-  }
-  // A split vertex's parent may be another split vertex: follow to the input.
-  for (IndexType & p : parents)
-  {
-    while (p >= m_InputPoints)
+    std::vector<IndexType> start(m_InputPoints + 1, 0);
+    for (std::size_t i = 0; i < numberOfPoints; ++i)
     {
-      p = m_Parents[p];
+      if (m_State[i] != RemesherRemoved)
+      {
+        ++start[root[i] + 1];
+      }
     }
+    for (std::size_t i = 0; i < m_InputPoints; ++i)
+    {
+      start[i + 1] += start[i];
+    }
+    const IndexType          kept = start[m_InputPoints];
+    std::vector<IndexType> & newIndex = m_NewIndex;
+    newIndex.assign(numberOfPoints, Invalid);
+    std::vector<IndexType> parents(kept);
+    std::vector<uint8_t>   state(kept);
+    std::vector<int32_t>   valence(kept);
+    coordinates.resize(3 * static_cast<std::size_t>(kept));
+    for (std::size_t i = 0; i < numberOfPoints; ++i)
+    {
+      if (m_State[i] != RemesherRemoved)
+      {
+        const IndexType k = start[root[i]]++;
+        newIndex[i] = k;
+        parents[k] = i < m_InputPoints ? static_cast<IndexType>(i) : m_Parents[i];
+        state[k] = m_State[i];
+        valence[k] = m_Valence[i];
+        std::copy(m_X.data() + 3 * i, m_X.data() + 3 * i + 3, coordinates.data() + 3 * static_cast<std::size_t>(k));
+      }
+    }
+    // A split vertex's parent may be another split vertex: follow to the input.
+    for (IndexType & p : parents)
+    {
+      while (p >= m_InputPoints)
+      {
+        p = m_Parents[p];
+      }
+    }
+    m_Parents.swap(parents);
+    m_State.swap(state);
+    m_Valence.swap(valence);
+
+    // The corner table in the new numbering: the remaining triangles in
+    // their order (an increasing map, so that each edge keeps the corner it
+    // is listed from).
+    std::vector<IndexType> & newCorner = m_NewCorner;
+    newCorner.assign(numberOfCorners, Invalid);
+    IndexType next = 0;
+    for (std::size_t c = 0; c < numberOfCorners; c += 3)
+    {
+      if (m_V[c] != Invalid)
+      {
+        newCorner[c] = next;
+        newCorner[c + 1] = next + 1;
+        newCorner[c + 2] = next + 2;
+        next += 3;
+      }
+    }
+    triangles.resize(next);
+    std::vector<int64_t> opposite(next);
+    bool                 consistent = true;
+    for (std::size_t c = 0; c < numberOfCorners; ++c)
+    {
+      const IndexType nc = newCorner[c];
+      if (nc == Invalid)
+      {
+        continue;
+      }
+      triangles[nc] = newIndex[m_V[c]];
+      const int64_t o = m_O[c];
+      if (o < 0)
+      {
+        opposite[nc] = o;
+      }
+      else
+      {
+        const IndexType no = newCorner[static_cast<std::size_t>(o)];
+        consistent = consistent && no != Invalid;
+        opposite[nc] = no != Invalid ? static_cast<int64_t>(no) : NonManifold;
+      }
+    }
+    m_V.assign(triangles.begin(), triangles.end());
+    m_O.swap(opposite);
+    // A table that does not describe the output is built again next time.
+    m_TableValid = consistent;
   }
-  m_Parents.swap(parents);
-  m_Edges.clear();
-  m_EdgesUnique = true;
+  // As Build() sets it: the first corner of each vertex.
+  m_VertexCorner.assign(m_State.size(), Invalid);
+  for (std::size_t c = m_V.size(); c-- > 0;)
+  {
+    m_VertexCorner[m_V[c]] = static_cast<IndexType>(c);
+  }
+}
+
+inline bool
+DeformableMeshRemesher::Edges(std::vector<uint64_t> & edges) const
+{
+  edges.clear();
+  bool unique = true;
   for (std::size_t c = 0; c < m_V.size(); ++c)
   {
     const int64_t o = m_O[c];
-    if (m_V[c] != Invalid && (o < 0 || static_cast<int64_t>(c) < o))
+    if (o < 0 || static_cast<int64_t>(c) < o)
     {
-      const uint64_t a = newIndex[m_V[c]];
-      const uint64_t b = newIndex[m_V[Next(static_cast<IndexType>(c))]];
-      m_Edges.push_back(std::min(a, b) << 32 | std::max(a, b));
-      m_EdgesUnique = m_EdgesUnique && o != NonManifold;
+      const uint64_t a = m_V[c];
+      const uint64_t b = m_V[Next(static_cast<IndexType>(c))];
+      edges.push_back(std::min(a, b) << 32 | std::max(a, b));
+      unique = unique && o != NonManifold;
     }
   }
-  triangles.clear();
-  for (std::size_t c = 0; c < m_V.size(); c += 3)
-  {
-    if (m_V[c] != Invalid)
-    {
-      triangles.push_back(newIndex[m_V[c]]);
-      triangles.push_back(newIndex[m_V[c + 1]]);
-      triangles.push_back(newIndex[m_V[c + 2]]);
-    }
-  }
+  return unique;
 }
 
 inline DeformableMeshRemesher::Statistics
@@ -1236,12 +1387,20 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
   m_Min2 = GetMinimumEdgeLength() * GetMinimumEdgeLength();
   m_Max2 = GetMaximumEdgeLength() * GetMaximumEdgeLength();
   m_X.assign(coordinates.begin(), coordinates.begin() + 3 * numberOfPoints);
-  m_V.assign(triangles.begin(), triangles.end());
   m_Parents.resize(numberOfPoints);
   std::iota(m_Parents.begin(), m_Parents.end(), IndexType{ 0 });
-  this->Build(numberOfPoints);
-
-  for (unsigned int pass = 0; pass < 16 && this->SplitPass(); ++pass)
+  // The table of the last output describes this input when it is given
+  // again: no need to build it.
+  const bool reuse = m_TableValid && m_State.size() == numberOfPoints && m_V.size() == triangles.size() &&
+                     std::equal(triangles.begin(), triangles.end(), m_V.begin());
+  m_TableValid = false;
+  if (!reuse)
+  {
+    m_V.assign(triangles.begin(), triangles.end());
+    this->Build(numberOfPoints);
+  }
+  m_TableValid = true;
+  for (unsigned int pass = 0; pass < 16 && this->SplitPass(pass == 0); ++pass)
   {}
   this->CollapsePass();
   this->FlipPass();
@@ -1249,7 +1408,7 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
   {
     this->Relax();
   }
-  for (unsigned int pass = 0; pass < 16 && this->SplitPass(); ++pass)
+  for (unsigned int pass = 0; pass < 16 && this->SplitPass(pass == 0); ++pass)
   {}
   this->CollapsePass();
   this->LengthenPass();
@@ -1301,6 +1460,62 @@ DeformableMeshRemesher::LocalityOrder(const double * coordinates, std::size_t nu
   std::vector<IndexType> order(numberOfPoints);
   std::iota(order.begin(), order.end(), IndexType{ 0 });
   std::stable_sort(order.begin(), order.end(), [&keys](IndexType a, IndexType b) { return keys[a] < keys[b]; });
+  return order;
+}
+
+inline std::vector<DeformableMeshRemesher::IndexType>
+DeformableMeshRemesher::BreadthFirstOrder(const double *                coordinates,
+                                          std::size_t                   numberOfPoints,
+                                          const std::vector<uint64_t> & edges)
+{
+  std::vector<IndexType> offsets(numberOfPoints + 1, 0);
+  for (const uint64_t e : edges)
+  {
+    ++offsets[(e >> 32) + 1];
+    ++offsets[(e & 0xffffffffULL) + 1];
+  }
+  for (std::size_t i = 0; i < numberOfPoints; ++i)
+  {
+    offsets[i + 1] += offsets[i];
+  }
+  std::vector<IndexType> neighbours(offsets[numberOfPoints]);
+  {
+    std::vector<IndexType> fill(offsets.begin(), offsets.end() - 1);
+    for (const uint64_t e : edges)
+    {
+      const auto a = static_cast<IndexType>(e >> 32);
+      const auto b = static_cast<IndexType>(e & 0xffffffffULL);
+      neighbours[fill[a]++] = b;
+      neighbours[fill[b]++] = a;
+    }
+  }
+  const std::vector<IndexType> starts = LocalityOrder(coordinates, numberOfPoints);
+  std::vector<uint8_t>         visited(numberOfPoints, 0);
+  std::vector<IndexType>       order;
+  order.reserve(numberOfPoints);
+  for (const IndexType start : starts)
+  {
+    if (visited[start])
+    {
+      continue;
+    }
+    visited[start] = 1;
+    std::size_t head = order.size();
+    order.push_back(start);
+    while (head < order.size())
+    {
+      const IndexType v = order[head++];
+      for (IndexType k = offsets[v]; k < offsets[v + 1]; ++k)
+      {
+        const IndexType w = neighbours[k];
+        if (!visited[w])
+        {
+          visited[w] = 1;
+          order.push_back(w);
+        }
+      }
+    }
+  }
   return order;
 }
 

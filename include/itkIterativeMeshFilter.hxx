@@ -294,19 +294,48 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::InstallChangedStructure()
   {
     using CellType = typename OutputMeshType::CellType;
     using TriangleType = TriangleCell<CellType>;
-    this->ReleaseOutputCells();
-    auto                cells = OutputCellsContainer::New();
     const SizeValueType numberOfTriangles = m_CachedTriangles.size() / 3;
+    // The triangle cells of the previous structure are taken over, with new
+    // point identifiers, unless someone other than the filter and its output
+    // (a downstream filter, an observer) still holds their container: a
+    // change of the structure (remeshing) then allocates no cell but for the
+    // triangles added.
+    std::vector<CellType *> recycled;
+    if (m_OutputCells &&
+        (m_OutputCells->GetReferenceCount() == 1 ||
+         (m_OutputCells->GetReferenceCount() == 2 && output->GetCells() == m_OutputCells.GetPointer())))
+    {
+      recycled.reserve(m_OutputCells->Size());
+      for (auto it = m_OutputCells->Begin(); it != m_OutputCells->End(); ++it)
+      {
+        CellType * cell = it.Value();
+        if (cell != nullptr && cell->GetType() == CommonEnums::CellGeometry::TRIANGLE_CELL)
+        {
+          recycled.push_back(cell);
+        }
+        else
+        {
+          delete cell;
+        }
+      }
+      m_OutputCells->CastToSTLContainer().clear();
+    }
+    this->ReleaseOutputCells();
+    auto cells = OutputCellsContainer::New();
     cells->Reserve(numberOfTriangles);
     auto & elements = cells->CastToSTLContainer();
     for (SizeValueType t = 0; t < numberOfTriangles; ++t)
     {
-      auto * triangle = new TriangleType;
+      CellType * triangle = t < recycled.size() ? recycled[t] : new TriangleType;
       for (unsigned int k = 0; k < 3; ++k)
       {
         triangle->SetPointId(k, m_CachedTriangles[3 * t + k]);
       }
       elements[t] = triangle;
+    }
+    for (SizeValueType t = numberOfTriangles; t < recycled.size(); ++t)
+    {
+      delete recycled[t];
     }
     m_OutputCells = cells;
     m_OutputCellsStale = false;

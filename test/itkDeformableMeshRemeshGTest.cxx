@@ -347,6 +347,57 @@ TEST(DeformableMeshRemesher, ClosedSphereStaysAClosedTwoManifoldWithEdgesInTheBa
   }
 }
 
+TEST(DeformableMeshRemesher, KeptTableGivesTheSameMeshAsAFreshOne)
+{
+  // Remesh() keeps the corner table of its output and reuses it when given
+  // that output again: each round (the points moved in between) must give,
+  // bit for bit, what a remesher that builds its table from the input gives.
+  PointType centre;
+  centre.Fill(0.0);
+  const auto                  sphere = itk::MakeSphereMesh<MeshType>(centre, 10.0, 3);
+  FlatMesh                    kept = ToFlat(sphere);
+  itk::DeformableMeshRemesher keeping;
+  keeping.SetTargetEdgeLength(1.5);
+  bool unchanged = false;
+  for (int round = 0; round < 12; ++round)
+  {
+    FlatMesh                    fresh = kept;
+    itk::DeformableMeshRemesher building;
+    building.SetTargetEdgeLength(1.5);
+    const auto statistics = keeping.Remesh(kept.x, kept.Points(), kept.triangles);
+    building.Remesh(fresh.x, fresh.Points(), fresh.triangles);
+    ASSERT_EQ(kept.triangles, fresh.triangles) << "round " << round;
+    ASSERT_EQ(kept.x, fresh.x) << "round " << round;
+    ASSERT_EQ(keeping.Parents(), building.Parents()) << "round " << round;
+    std::vector<uint64_t> edgesKept;
+    std::vector<uint64_t> edgesFresh;
+    EXPECT_EQ(keeping.Edges(edgesKept), building.Edges(edgesFresh));
+    ASSERT_EQ(edgesKept, edgesFresh) << "round " << round;
+    EXPECT_EQ(keeping.GetTopologyChanged(), statistics.splits + statistics.collapses + statistics.flips > 0);
+    unchanged = unchanged || !keeping.GetTopologyChanged();
+    // A stretch along z, as a deformation between remeshings.
+    for (std::size_t i = 0; i < kept.Points(); ++i)
+    {
+      kept.x[3 * i + 2] *= 1.04;
+    }
+  }
+  EXPECT_FALSE(unchanged) << "the stretch makes every round change the mesh";
+  // With a band wide enough that no edge leaves it, a round after the flips
+  // toward valence 6 are done changes no connectivity: the numbering and
+  // the triangles stay, only the relaxation moves points.
+  keeping.SetEdgeLengthRatios(0.01, 100.0);
+  keeping.Remesh(kept.x, kept.Points(), kept.triangles);
+  keeping.Remesh(kept.x, kept.Points(), kept.triangles);
+  const FlatMesh before = kept;
+  const auto     statistics = keeping.Remesh(kept.x, kept.Points(), kept.triangles);
+  EXPECT_EQ(statistics.splits + statistics.collapses + statistics.flips, 0u);
+  EXPECT_FALSE(keeping.GetTopologyChanged());
+  EXPECT_EQ(kept.triangles, before.triangles);
+  EXPECT_EQ(kept.Points(), before.Points());
+  EXPECT_NE(kept.x, before.x) << "the relaxation moved points";
+  EXPECT_GT(statistics.relaxed, 0u);
+}
+
 TEST(DeformableMeshRemesher, LeavesNonManifoldPartsAlone)
 {
   // Three triangles on one edge (0, 1), fins of a book: frozen, nothing
