@@ -20,7 +20,9 @@ repo=$(pwd)
 version=${1:-5.2.1}
 
 start=$(date +%s)
-itk=$(EDM_ITK_WRAP_PYTHON=ON scripts/build-itk.sh "$version" "$repo" | tail -n 1)
+itk=$(EDM_ITK_WRAP_PYTHON=ON scripts/build-itk.sh "$version" "$repo") || {
+  echo "ci-itk-python: the wrapped ITK $version tree did not build ($(($(date +%s) - start)) s)" >&2; exit 1; }
+itk=$(printf '%s\n' "$itk" | tail -n 1)
 built=$(date +%s)
 
 python_dir="$itk/Wrapping/Generators/Python"
