@@ -461,9 +461,9 @@ template <typename TInputImage, typename TOutputImage>
 OffsetValueType
 ExternalForceImageFilter<TInputImage, TOutputImage>::LocateLine(SizeValueType    line,
                                                                 const SizeType & size,
-                                                                const OffsetValueType (&stride)[ImageDimension],
-                                                                OffsetValueType (&lower)[ImageDimension],
-                                                                OffsetValueType (&upper)[ImageDimension])
+                                                                const OffsetValueType * stride,
+                                                                OffsetValueType *       lower,
+                                                                OffsetValueType *       upper)
 {
   OffsetValueType start = 0;
   for (unsigned int d = 1; d < ImageDimension; ++d)
