@@ -185,8 +185,8 @@ private:
    * The three arrays have ImageDimension elements (pointers, not references
    * to arrays: ITK 5.2's wrapping writes those in a form SWIG cannot parse). */
   static OffsetValueType
-  LocateLine(SizeValueType    line,
-             const SizeType & size,
+  LocateLine(SizeValueType           line,
+             const SizeType &        size,
              const OffsetValueType * stride,
              OffsetValueType *       lower,
              OffsetValueType *       upper);

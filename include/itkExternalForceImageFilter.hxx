@@ -459,8 +459,8 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::GaussianTailSum(double firs
 
 template <typename TInputImage, typename TOutputImage>
 OffsetValueType
-ExternalForceImageFilter<TInputImage, TOutputImage>::LocateLine(SizeValueType    line,
-                                                                const SizeType & size,
+ExternalForceImageFilter<TInputImage, TOutputImage>::LocateLine(SizeValueType           line,
+                                                                const SizeType &        size,
                                                                 const OffsetValueType * stride,
                                                                 OffsetValueType *       lower,
                                                                 OffsetValueType *       upper)
