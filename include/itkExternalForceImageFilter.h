@@ -181,13 +181,15 @@ private:
   /** Start (buffer offset) of line number \a line of pixels along x, and the
    * offsets from a pixel of that line to its lower and upper neighbours along
    * the other axes: 0 at the border, so that a missing neighbour is the pixel
-   * itself (zero-flux boundary). lower[0] and upper[0] are left to the caller. */
+   * itself (zero-flux boundary). lower[0] and upper[0] are left to the caller.
+   * The three arrays have ImageDimension elements (pointers, not references
+   * to arrays: ITK 5.2's wrapping writes those in a form SWIG cannot parse). */
   static OffsetValueType
-  LocateLine(SizeValueType    line,
-             const SizeType & size,
-             const OffsetValueType (&stride)[ImageDimension],
-             OffsetValueType (&lower)[ImageDimension],
-             OffsetValueType (&upper)[ImageDimension]);
+  LocateLine(SizeValueType           line,
+             const SizeType &        size,
+             const OffsetValueType * stride,
+             OffsetValueType *       lower,
+             OffsetValueType *       upper);
 
   /** Central differences of \a image on its buffer, threaded over lines:
    * calls function(offset, derivative) for every pixel, derivative[d] being

@@ -459,11 +459,11 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::GaussianTailSum(double firs
 
 template <typename TInputImage, typename TOutputImage>
 OffsetValueType
-ExternalForceImageFilter<TInputImage, TOutputImage>::LocateLine(SizeValueType    line,
-                                                                const SizeType & size,
-                                                                const OffsetValueType (&stride)[ImageDimension],
-                                                                OffsetValueType (&lower)[ImageDimension],
-                                                                OffsetValueType (&upper)[ImageDimension])
+ExternalForceImageFilter<TInputImage, TOutputImage>::LocateLine(SizeValueType           line,
+                                                                const SizeType &        size,
+                                                                const OffsetValueType * stride,
+                                                                OffsetValueType *       lower,
+                                                                OffsetValueType *       upper)
 {
   OffsetValueType start = 0;
   for (unsigned int d = 1; d < ImageDimension; ++d)

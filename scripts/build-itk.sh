@@ -124,6 +124,19 @@ if [ "$wrap_python" = ON ] && [ -f "$src/Wrapping/Generators/Python/module_ext.i
   grep -q SWIGPY_SLICEOBJECT "$src/Wrapping/Generators/Python/module_ext.i.in" || {
     echo "build-itk: could not define SWIGPY_SLICEOBJECT in ITK's module_ext.i.in" >&2; exit 2; }
 fi
+grg="$src/Modules/Filtering/ImageGradient/wrapping/itkGradientRecursiveGaussianImageFilter.wrap"
+if [ "$wrap_python" = ON ] && [ -f "$grg" ] && grep -q 'ITKM_I${cv}2${image_dim}' "$grg"; then
+  # ITK's wrapping of GradientRecursiveGaussianImageFilter for scalar images
+  # names its output ICVF2<dim> (a 2-component covariant vector whatever the
+  # image's dimension), which exists only when ITK_WRAP_VECTOR_COMPONENTS
+  # includes 2. With ITK_WRAP_IMAGE_DIMS=3 it does not (3;4), the template
+  # argument is empty and castxml stops the build. The gradient of a scalar
+  # image has one component per image dimension: ICVF<dim><dim>, the filter's
+  # default output type. Wrapping only.
+  sed -i 's/ITKM_I${cv}2${image_dim}/ITKM_I${cv}${image_dim}${image_dim}/; s/ITKT_I${cv}2${image_dim}/ITKT_I${cv}${image_dim}${image_dim}/' "$grg"
+  ! grep -q '${cv}2${image_dim}' "$grg" || {
+    echo "build-itk: could not patch $grg" >&2; exit 2; }
+fi
 if [ -n "$module_dir" ]; then
   # Inside ITK's tree: Modules/Remote/<name> is where ITK's own
   # *.remote.cmake files fetch a remote module to.

@@ -20,15 +20,21 @@ repo=$(pwd)
 version=${1:-5.2.1}
 
 start=$(date +%s)
-itk=$(EDM_ITK_WRAP_PYTHON=ON scripts/build-itk.sh "$version" "$repo" | tail -n 1)
+itk=$(EDM_ITK_WRAP_PYTHON=ON scripts/build-itk.sh "$version" "$repo") || {
+  echo "ci-itk-python: the wrapped ITK $version tree did not build ($(($(date +%s) - start)) s)" >&2; exit 1; }
+itk=$(printf '%s\n' "$itk" | tail -n 1)
 built=$(date +%s)
 
 python_dir="$itk/Wrapping/Generators/Python"
 [ -f "$python_dir/itk/__init__.py" ] || { echo "ci-itk-python: no itk package in $python_dir" >&2; exit 1; }
 ls "$python_dir"/itk/*ExplicitDeformableModel* > /dev/null 2>&1 || ls "$itk"/lib/*ExplicitDeformableModel*Python* > /dev/null 2>&1 || {
   echo "ci-itk-python: the module's Python wrapping was not built in $itk" >&2; exit 1; }
+# The interpreter ITK was wrapped for (build-itk.sh: /usr/bin/python3), not
+# whichever python3 comes first on PATH (a pyenv shim has neither these
+# headers' ABI nor numpy).
+python=${EDM_PYTHON:-/usr/bin/python3}
 status=0
-env PYTHONPATH="$python_dir:$itk/lib" python3 wrapping/test/itkDeformableMeshFilterPythonTest.py || status=$?
+env PYTHONPATH="$python_dir:$itk/lib" "$python" wrapping/test/itkDeformableMeshFilterPythonTest.py || status=$?
 end=$(date +%s)
 echo "ci-itk-python: ITK $version wrapped tree $((built - start)) s, Python test $((end - built)) s, status $status"
 exit $status
