@@ -29,5 +29,7 @@ export EDM_NO_MEMORY_LIMIT=1
 # (ThreeHundredSteps): at -O1 the compiler inlines and contracts into FMAs
 # differently, so the bits of a 300-step run differ by rounding; stage 1
 # checks them in the Release build, and the sanitizers still run every other
-# test of the step.
-ctest --test-dir "$build" --output-on-failure -j2 -E "InstallDownstream|^validation\.|KernelPath|ThreeHundredSteps"
+# test of the step. Nor the resolution study (SameParametersGiveTheSameSurface:
+# 15 runs up to 65 538 vertices, 6.5 minutes under the sanitizers; the same
+# code runs in the sanitized tests of smaller meshes).
+ctest --test-dir "$build" --output-on-failure -j2 -E "InstallDownstream|^validation\.|KernelPath|ThreeHundredSteps|SameParametersGiveTheSameSurface"
