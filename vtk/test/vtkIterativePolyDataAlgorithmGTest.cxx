@@ -661,47 +661,61 @@ TEST(VTKIterativeAlgorithms, ProgressIsReportedAndAbortStopsBetweenSteps)
   EXPECT_EQ(Coordinates(warp->GetOutput()), ReferenceWarp(sphere, 20, 1.0, 0));
 }
 
+/** The region-force cases: the test ellipsoid's intensities riding on a zero
+ * force image as its active scalars (as vtkExternalForceField's output
+ * carries them), a sphere 5 mm inside it, and the model's parameters, set
+ * alike on the VTK and the ITK class. */
+struct RegionForceCase
+{
+  ImageType::Pointer            image = MakeEllipsoidImage(); // 255 inside, 0 outside
+  ForceImageType::Pointer       forces = MakeForces();
+  vtkSmartPointer<vtkImageData> forceImage;
+  vtkSmartPointer<vtkPolyData>  sphere = MakeSphere(5.0, Center);
+
+  RegionForceCase()
+  {
+    forces->FillBuffer(itk::CovariantVector<float, 3>(0.0f));
+    forceImage = edm::ImageToImageData(forces.GetPointer(), "Force");
+    const auto intensities = edm::ImageToImageData(image.GetPointer(), "Intensity");
+    forceImage->GetPointData()->AddArray(intensities->GetPointData()->GetArray("Intensity"));
+    forceImage->GetPointData()->SetActiveScalars("Intensity");
+  }
+
+  template <typename TFilter>
+  static void
+  SetModel(TFilter * filter)
+  {
+    filter->SetScaleFactor(0.0);
+    filter->SetRegionWeight(0.25);
+    filter->SetElasticity(0.3);
+    filter->SetTangentialElasticity(false);
+    filter->SetRigidity(0.05);
+    filter->SetNumberOfIterations(600);
+  }
+};
+
 TEST(VTKIterativeAlgorithms, DeformableMeshRegionForceIsTheITKFilterAndStopsOnTheEllipsoid)
 {
-  // The intensities ride on the force image as its active scalars, as
-  // vtkExternalForceField's output carries them; no external force.
-  const auto image = MakeEllipsoidImage();
-  const auto forces = MakeForces();
-  forces->FillBuffer(itk::CovariantVector<float, 3>(0.0f));
-  auto       forceImage = edm::ImageToImageData(forces.GetPointer(), "Force");
-  const auto intensities = edm::ImageToImageData(image.GetPointer(), "Intensity");
-  forceImage->GetPointData()->AddArray(intensities->GetPointData()->GetArray("Intensity"));
-  forceImage->GetPointData()->SetActiveScalars("Intensity");
-  auto sphere = MakeSphere(5.0, Center);
+  RegionForceCase c;
 
   vtkNew<vtkDeformableMesh> deformable;
-  deformable->SetInputData(sphere);
-  deformable->SetForceImageData(forceImage);
-  deformable->SetScaleFactor(0.0);
-  deformable->SetRegionWeight(0.25);
-  deformable->SetElasticity(0.3);
-  deformable->SetTangentialElasticity(false);
-  deformable->SetRigidity(0.05);
-  deformable->SetNumberOfIterations(600);
+  deformable->SetInputData(c.sphere);
+  deformable->SetForceImageData(c.forceImage);
+  RegionForceCase::SetModel(deformable.GetPointer());
   deformable->Update();
 
   auto filter = itk::DeformableMeshFilter<MeshType, ForceImageType>::New();
-  filter->SetInput(ToITK(sphere));
-  filter->SetForceImage(forces);
-  filter->SetIntensityImage(image);
-  filter->SetScaleFactor(0.0);
-  filter->SetRegionWeight(0.25);
-  filter->SetElasticity(0.3);
-  filter->SetTangentialElasticity(false);
-  filter->SetRigidity(0.05);
-  filter->SetNumberOfIterations(600);
+  filter->SetInput(ToITK(c.sphere));
+  filter->SetForceImage(c.forces);
+  filter->SetIntensityImage(c.image);
+  RegionForceCase::SetModel(filter.GetPointer());
   filter->Update();
   EXPECT_EQ(Coordinates(deformable->GetOutput()), Coordinates(filter->GetOutput()));
   // Known answer: from 5 mm inside everywhere to the ellipsoid's surface.
   EXPECT_LT(MeanDistanceToEllipsoid(deformable->GetOutput()), 0.3);
 
   // Without intensities: an error and an empty output.
-  forceImage->GetPointData()->RemoveArray("Intensity");
+  c.forceImage->GetPointData()->RemoveArray("Intensity");
   ErrorRecorder errors(deformable);
   deformable->Modified();
   deformable->Update();
@@ -716,41 +730,24 @@ TEST(VTKIterativeAlgorithms, DeformableMeshRegionForceIsTheITKFilterAndStopsOnTh
 // whose bounds are not in order is an error.
 TEST(VTKIterativeAlgorithms, DeformableMeshGivenObjectRangeIsTheITKFilters)
 {
-  const auto image = MakeEllipsoidImage(); // 255 inside, 0 outside
-  const auto forces = MakeForces();
-  forces->FillBuffer(itk::CovariantVector<float, 3>(0.0f));
-  auto       forceImage = edm::ImageToImageData(forces.GetPointer(), "Force");
-  const auto intensities = edm::ImageToImageData(image.GetPointer(), "Intensity");
-  forceImage->GetPointData()->AddArray(intensities->GetPointData()->GetArray("Intensity"));
-  forceImage->GetPointData()->SetActiveScalars("Intensity");
-  auto sphere = MakeSphere(5.0, Center);
+  RegionForceCase c;
 
   vtkNew<vtkDeformableMesh> deformable;
-  deformable->SetInputData(sphere);
-  deformable->SetForceImageData(forceImage);
-  deformable->SetScaleFactor(0.0);
-  deformable->SetRegionWeight(0.25);
-  deformable->SetElasticity(0.3);
-  deformable->SetTangentialElasticity(false);
-  deformable->SetRigidity(0.05);
+  deformable->SetInputData(c.sphere);
+  deformable->SetForceImageData(c.forceImage);
+  RegionForceCase::SetModel(deformable.GetPointer());
   deformable->EstimateObjectIntensityRangeOff();
   deformable->SetObjectIntensityRange(127.5, 1000.0);
   deformable->SetEdgePolarity(1);
-  deformable->SetNumberOfIterations(600);
   deformable->Update();
 
   auto filter = itk::DeformableMeshFilter<MeshType, ForceImageType>::New();
-  filter->SetInput(ToITK(sphere));
-  filter->SetForceImage(forces);
-  filter->SetIntensityImage(image);
-  filter->SetScaleFactor(0.0);
-  filter->SetRegionWeight(0.25);
-  filter->SetElasticity(0.3);
-  filter->SetTangentialElasticity(false);
-  filter->SetRigidity(0.05);
+  filter->SetInput(ToITK(c.sphere));
+  filter->SetForceImage(c.forces);
+  filter->SetIntensityImage(c.image);
+  RegionForceCase::SetModel(filter.GetPointer());
   filter->SetObjectIntensityRange(127.5, 1000.0, 87.25);
   filter->SetEdgePolarity(1);
-  filter->SetNumberOfIterations(600);
   filter->Update();
   EXPECT_DOUBLE_EQ(filter->GetObjectIntensityLower(), 127.5);
   EXPECT_EQ(Coordinates(deformable->GetOutput()), Coordinates(filter->GetOutput()));
