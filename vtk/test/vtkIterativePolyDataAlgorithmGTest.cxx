@@ -692,23 +692,37 @@ struct RegionForceCase
     filter->SetRigidity(0.05);
     filter->SetNumberOfIterations(600);
   }
+
+  vtkSmartPointer<vtkDeformableMesh>
+  VTKFilter() const
+  {
+    auto deformable = vtkSmartPointer<vtkDeformableMesh>::New();
+    deformable->SetInputData(sphere);
+    deformable->SetForceImageData(forceImage);
+    SetModel(deformable.GetPointer());
+    return deformable;
+  }
+
+  itk::DeformableMeshFilter<MeshType, ForceImageType>::Pointer
+  ITKFilter() const
+  {
+    auto filter = itk::DeformableMeshFilter<MeshType, ForceImageType>::New();
+    filter->SetInput(ToITK(sphere));
+    filter->SetForceImage(forces);
+    filter->SetIntensityImage(image);
+    SetModel(filter.GetPointer());
+    return filter;
+  }
 };
 
 TEST(VTKIterativeAlgorithms, DeformableMeshRegionForceIsTheITKFilterAndStopsOnTheEllipsoid)
 {
   RegionForceCase c;
 
-  vtkNew<vtkDeformableMesh> deformable;
-  deformable->SetInputData(c.sphere);
-  deformable->SetForceImageData(c.forceImage);
-  RegionForceCase::SetModel(deformable.GetPointer());
+  auto deformable = c.VTKFilter();
   deformable->Update();
 
-  auto filter = itk::DeformableMeshFilter<MeshType, ForceImageType>::New();
-  filter->SetInput(ToITK(c.sphere));
-  filter->SetForceImage(c.forces);
-  filter->SetIntensityImage(c.image);
-  RegionForceCase::SetModel(filter.GetPointer());
+  auto filter = c.ITKFilter();
   filter->Update();
   EXPECT_EQ(Coordinates(deformable->GetOutput()), Coordinates(filter->GetOutput()));
   // Known answer: from 5 mm inside everywhere to the ellipsoid's surface.
@@ -732,20 +746,13 @@ TEST(VTKIterativeAlgorithms, DeformableMeshGivenObjectRangeIsTheITKFilters)
 {
   RegionForceCase c;
 
-  vtkNew<vtkDeformableMesh> deformable;
-  deformable->SetInputData(c.sphere);
-  deformable->SetForceImageData(c.forceImage);
-  RegionForceCase::SetModel(deformable.GetPointer());
+  auto deformable = c.VTKFilter();
   deformable->EstimateObjectIntensityRangeOff();
   deformable->SetObjectIntensityRange(127.5, 1000.0);
   deformable->SetEdgePolarity(1);
   deformable->Update();
 
-  auto filter = itk::DeformableMeshFilter<MeshType, ForceImageType>::New();
-  filter->SetInput(ToITK(c.sphere));
-  filter->SetForceImage(c.forces);
-  filter->SetIntensityImage(c.image);
-  RegionForceCase::SetModel(filter.GetPointer());
+  auto filter = c.ITKFilter();
   filter->SetObjectIntensityRange(127.5, 1000.0, 87.25);
   filter->SetEdgePolarity(1);
   filter->Update();
