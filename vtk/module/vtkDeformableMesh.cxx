@@ -36,7 +36,6 @@
 #include "vtkPointData.h"
 #include "vtkPolyData.h"
 
-#include <cmath>
 #include <new>
 #include <vector>
 
@@ -257,14 +256,10 @@ vtkDeformableMesh::PrepareFilter(vtkInformationVector ** inputVector)
   }
   else
   {
+    // The ITK filter checks the range at its reset (finite, in order, a
+    // positive width): a reversed or empty range is its exception.
     const double lower = this->ObjectIntensityRange[0];
     const double upper = this->ObjectIntensityRange[1];
-    if (!(lower < upper) || !std::isfinite(upper - lower))
-    {
-      vtkErrorMacro("ObjectIntensityRange must be finite with its lower bound below its upper bound, got ["
-                    << lower << ", " << upper << "].");
-      return 0;
-    }
     filter->SetObjectIntensityRange(lower, upper, 0.1 * (upper - lower));
   }
   filter->SetEdgePolarity(this->EdgePolarity);

@@ -767,7 +767,7 @@ TEST(VTKIterativeAlgorithms, DeformableMeshGivenObjectRangeIsTheITKFilters)
   deformable->SetObjectIntensityRange(200.0, 100.0);
   deformable->Update();
   EXPECT_GE(errors.Count(), 1);
-  EXPECT_NE(errors.Messages().find("ObjectIntensityRange"), std::string::npos) << errors.Messages();
+  EXPECT_NE(errors.Messages().find("object intensity range"), std::string::npos) << errors.Messages();
   EXPECT_EQ(deformable->GetOutput()->GetNumberOfPoints(), 0);
 }
 
