@@ -653,33 +653,60 @@ StoreBox(const double * lower, const double * upper, double margin, float * box)
  * (A, B) violates the constraint at y when their distance is below the
  * minimum distance d and below their distance at x: a pair that was already
  * closer than d may stay so but not come closer, and from a state without
- * intersection (distance 0) none is created. The vertices of violating pairs get their displacements halved,
- * at the next violation halved again, at the third set to zero; the pairs of
- * every modified triangle are tested again until none violates. This
- * terminates (at worst every displacement is zero, which gives back x) and
- * the result is a state in which no pair that did not intersect at x
- * intersects, and no pair that was at least d apart is closer than d.
+ * intersection (distance 0) none is created. The vertices of violating
+ * pairs get their displacements halved, at the next violation halved again,
+ * at the third set to zero; the pairs of every modified triangle are tested
+ * again until none violates. This terminates (at worst every displacement
+ * is zero, which gives back x) and the result is a state in which no pair
+ * that did not intersect at x intersects, and no pair that was at least d
+ * apart is closer than d.
  *
- * The spatial index: each point i has a reference position r_i (x at the
- * last rebuild) and a box it may move in: the box swept by its displacement
- * y_i - x_i of that step and two more of the same, widened by a quarter of
- * the mean edge length. A triangle's box is the union of its points' boxes,
- * widened by d/2; the boxes are entered in a uniform hashed grid. Two
- * triangles whose boxes do not overlap are more than d apart as long as
- * every point stays in its box. Each triangle also keeps a clearance: a
- * lower bound of its distance at the reference positions to the triangles
- * whose boxes overlap its own, less d (bounding spheres; the exact distance
- * where the spheres are close). At each Constrain() the motion
- * m_i = max(|x_i - r_i|, |y_i - r_i|) of every point is computed; where some
- * y_i leaves its box, the index is rebuilt at x. Only the triangles whose
- * motion m_T (largest of their points') plus the largest motion M of all
- * points reaches their clearance are tested, against the triangles of the
- * grid near them: on a surface that has settled, a step costs a pass over
- * the points and one over the triangles; a surface that moves fast rebuilds
- * the index every two or three steps.
+ * The index bounds the relative motion of nearby triangles, not their
+ * absolute motion, so that a surface that moves fast as a whole (a balloon)
+ * needs no more work than one at rest. At a rebuild, at reference positions
+ * r (the proposed positions y of that step):
+ * - the candidate pairs: the pairs sharing no vertex closer than a radius
+ *   R = d + 0.75 mean edge lengths (found with a uniform grid of the
+ *   triangles' boxes widened by R/2), each with its exact distance at r
+ *   (rounded down); every other pair is at least R apart at r. Each
+ *   triangle's clearance is the smallest distance of its candidates, at most
+ *   R, less d;
+ * - a pyramid of cells: level 0 has cells of side s = R + 2 rmax (rmax the
+ *   largest distance from a triangle's centroid to its vertices), each
+ *   triangle in the cell of its centroid, so that every candidate of a
+ *   triangle is in one of the 27 cells around its own; level k has cells of
+ *   side 2^k s; the top level has at most two cells along each axis.
+ * At each step the displacement y - r of every vertex is taken, and for
+ * every triangle the box of its vertices' displacements; the box of a cell
+ * is the union of its triangles', and its neighbourhood box the union over
+ * the 27 cells around it. Two points of triangles t and u move apart or
+ * together by at most the largest distance between a point of t's box and
+ * one of u's (the points of a triangle are convex combinations of its
+ * vertices). Hence, with the distance d(t, u) at r:
+ * - a pair whose level-k cells are neighbours but whose level-(k-1) cells
+ *   are not is at least 2^(k-1) s - 2 rmax apart at r: such pairs are clear
+ *   when, for every level-k cell, the largest distance between its box and
+ *   its neighbourhood box is below 2^(k-1) s - 2 rmax - d;
+ * - a pair of neighbouring level-0 cells is clear when the largest distance
+ *   rho_t between t's box and the neighbourhood box of its cell is below
+ *   d(t, u) - d: below R - d for the pairs that are not candidates, below
+ *   the clearance of t for all of them.
+ * When a level's bound or some rho_t reaches R - d the index is rebuilt at
+ * the proposed positions y (where every displacement is zero, so that every
+ * bound holds); a pair that violates the constraint at y is then closer
+ * than d at the reference, within its triangles' clearance, and tested.
+ * Only the triangles whose rho_t reaches their clearance ("tested
+ * triangles") have their candidate pairs looked at, each first against the
+ * pair's own bound (the largest distance between the two triangles' boxes
+ * against d(t, u) - d) and then exactly. A surface moving as a whole, or
+ * settled, costs a pass over the points, one over the triangles and one
+ * over the cells per step. Once some displacements are reduced the modified
+ * triangles are tested against every triangle whose box swept from x to y
+ * (a uniform grid built for that step) comes within d of theirs: every
+ * state that the reductions make lies in those boxes.
  *
  * CountSelfIntersections() counts the intersecting pairs of a surface with
- * the same grid (exact triangle boxes).
+ * a grid of exact triangle boxes.
  *
  * \ingroup ExplicitDeformableModel
  */
@@ -771,6 +798,22 @@ public:
     return m_NumberOfRebuilds;
   }
 
+  /** Triangles whose candidate pairs the last Constrain() looked at (their
+   * relative motion reached their clearance). */
+  SizeValueType
+  GetNumberOfTestedTriangles() const
+  {
+    return m_NumberOfTestedTriangles;
+  }
+
+  /** Candidate pairs of the index (pairs closer than its radius at the
+   * reference positions), for diagnostics. */
+  SizeValueType
+  GetNumberOfCandidatePairs() const
+  {
+    return m_Candidates.size() / 2;
+  }
+
   /** The points whose displacement the last Constrain() reduced. */
   const std::vector<IndexType> &
   GetConstrainedPoints() const
@@ -798,13 +841,13 @@ public:
     const SizeValueType n = m_NumberOfPoints;
     const SizeValueType numberOfTriangles = this->GetNumberOfTriangles();
     m_ModifiedPoints.clear();
+    m_NumberOfTestedTriangles = 0;
     if (n == 0 || numberOfTriangles < 2)
     {
       return result;
     }
-    if (m_Motion.size() != n)
+    if (m_Level.size() != n)
     {
-      m_Motion.assign(n, 0.0f);
       m_Level.assign(n, 0);
       m_IndexValid = false;
     }
@@ -813,7 +856,7 @@ public:
       m_IndexValid = false;
     }
     const auto parallel = [threader, workUnits](SizeValueType count, auto && body) {
-      constexpr SizeValueType block = 4096;
+      constexpr SizeValueType block = 1024;
       const SizeValueType     blocks = (count + block - 1) / block;
       const auto              run = [&](SizeValueType b) { body(b * block, std::min(count, (b + 1) * block)); };
       if (threader == nullptr || blocks < 2 || workUnits < 2)
@@ -830,121 +873,107 @@ public:
       }
     };
 
-    // Motion of every point since the reference positions; a point out of
-    // its box makes the index be rebuilt.
-    float largest = 0.0f;
+    // The bounds at y; when one fails the index is rebuilt at y (where
+    // every displacement is zero and every bound holds).
+    bool bounded = false;
     if (m_IndexValid)
     {
-      std::atomic<bool>  escaped{ false };
-      std::atomic<bool>  nonFinite{ false };
-      std::vector<float> blockLargest((n + 4095) / 4096, 0.0f);
-      parallel(n, [&](SizeValueType begin, SizeValueType end) {
-        float top = 0.0f;
-        bool  out = false;
-        for (SizeValueType i = begin; i < end; ++i)
-        {
-          const double * r = m_Reference.data() + 3 * i;
-          const double * p = x + 3 * i;
-          const double * q = y + 3 * i;
-          const double   a =
-            (p[0] - r[0]) * (p[0] - r[0]) + (p[1] - r[1]) * (p[1] - r[1]) + (p[2] - r[2]) * (p[2] - r[2]);
-          const double b =
-            (q[0] - r[0]) * (q[0] - r[0]) + (q[1] - r[1]) * (q[1] - r[1]) + (q[2] - r[2]) * (q[2] - r[2]);
-          const double m = std::sqrt(std::max(a, b));
-          const float  mf = RoundUp(m);
-          m_Motion[i] = mf;
-          top = std::max(top, mf);
-          const float * box = m_VertexBoxes.data() + 6 * i;
-          out = out || !(box[0] <= q[0] && q[0] <= box[3] && box[1] <= q[1] && q[1] <= box[4] && box[2] <= q[2] &&
-                         q[2] <= box[5]);
-          if (!std::isfinite(m))
-          {
-            nonFinite = true;
-          }
-        }
-        blockLargest[begin / 4096] = top;
-        if (out)
-        {
-          escaped = true;
-        }
-      });
-      if (nonFinite)
+      const BoundStatus status = this->Bound(y, parallel);
+      if (status == BoundStatus::NonFinite)
       {
         return result; // a diverged step: the filter reports it
       }
-      largest = *std::max_element(blockLargest.begin(), blockLargest.end());
-      if (escaped)
-      {
-        m_IndexValid = false;
-      }
+      bounded = status == BoundStatus::Bounded;
     }
-    const SizeValueType                                       blocks = (numberOfTriangles + 4095) / 4096;
-    std::vector<std::vector<std::pair<IndexType, IndexType>>> found(blocks);
-    const bool                                                rebuild = !m_IndexValid;
-    if (rebuild)
+    if (!bounded)
     {
-      // The rebuild tests the pairs that may violate as it computes the
-      // clearances.
-      if (!this->Build(x, y, minimumDistance, parallel, found))
+      if (!this->Build(y, minimumDistance, parallel))
       {
         return result; // a diverged step: the filter reports it
       }
       result.rebuilt = true;
-      largest = *std::max_element(m_Motion.begin(), m_Motion.end());
+      const BoundStatus status = this->Bound(y, parallel);
+      if (status == BoundStatus::NonFinite)
+      {
+        return result;
+      }
+      bounded = status == BoundStatus::Bounded;
     }
     const double d = std::max(minimumDistance, m_ContactDistance);
 
-    // Triangles that may violate: their motion plus the largest motion reach
-    // their clearance; the pairs of two active triangles are tested by the
-    // one of lower index, those whose bound at the reference less d exceeds
-    // the two triangles' motions not at all.
-    if (!rebuild)
+    std::vector<std::pair<IndexType, IndexType>> violating;
+    bool                                         sweptGridBuilt = false;
+    const auto                                   buildSweptGrid = [&]() {
+      if (!sweptGridBuilt)
+      {
+        this->BuildSweptGrid(x, y, d, parallel);
+        sweptGridBuilt = true;
+      }
+    };
+    if (bounded)
     {
-      m_Active.resize(numberOfTriangles);
+      // The tested triangles' candidate pairs: the pairs of two tested
+      // triangles from the one of lower index.
+      const SizeValueType                                       blocks = (numberOfTriangles + 1023) / 1024;
+      std::vector<std::vector<std::pair<IndexType, IndexType>>> found(blocks);
+      std::vector<SizeValueType>                                tested(blocks, 0);
       parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
-        for (SizeValueType t = begin; t < end; ++t)
-        {
-          const IndexType * v = m_Triangles.data() + 3 * t;
-          const float       mt = std::max({ m_Motion[v[0]], m_Motion[v[1]], m_Motion[v[2]] });
-          m_TriangleMotion[t] = mt;
-          m_Active[t] = mt > 0.0f && static_cast<double>(mt) + static_cast<double>(largest) >= m_Clearance[t];
-        }
-      });
-      parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
-        auto & out = found[begin / 4096];
+        auto &        out = found[begin / 1024];
+        SizeValueType count = 0;
         for (SizeValueType t = begin; t < end; ++t)
         {
           if (!m_Active[t])
           {
             continue;
           }
-          const double * st = m_Spheres.data() + 4 * t;
-          m_Grid.ForEachOverlap(t, [&](SizeValueType u) {
-            if ((m_Active[u] && u < t) ||
-                SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
+          ++count;
+          const float * bt = m_TriangleDelta.data() + 6 * t;
+          for (SizeValueType c = m_CandidateOffsets[t]; c < m_CandidateOffsets[t + 1]; ++c)
+          {
+            const IndexType u = m_Candidates[c];
+            if (m_Active[u] && u < t)
             {
-              return;
+              continue;
             }
-            const double * su = m_Spheres.data() + 4 * u;
-            double         e[3];
-            SurfaceCollisionDetail::Subtract(st, su, e);
-            if (std::sqrt(SurfaceCollisionDetail::Dot(e, e)) - st[3] - su[3] - d >
-                static_cast<double>(m_TriangleMotion[t]) + static_cast<double>(m_TriangleMotion[u]))
+            if (LargestDistance(bt, m_TriangleDelta.data() + 6 * u) < static_cast<double>(m_CandidateGaps[c]) - d)
             {
-              return;
+              continue;
             }
             if (this->Violates(t, u, x, y, d))
             {
-              out.emplace_back(static_cast<IndexType>(std::min(t, u)), static_cast<IndexType>(std::max(t, u)));
+              out.emplace_back(static_cast<IndexType>(std::min<SizeValueType>(t, u)),
+                               static_cast<IndexType>(std::max<SizeValueType>(t, u)));
             }
-          });
+          }
         }
+        tested[begin / 1024] = count;
       });
+      for (SizeValueType b = 0; b < blocks; ++b)
+      {
+        m_NumberOfTestedTriangles += tested[b];
+        violating.insert(violating.end(), found[b].begin(), found[b].end());
+      }
     }
-    std::vector<std::pair<IndexType, IndexType>> violating;
-    for (const auto & block : found)
+    else
     {
-      violating.insert(violating.end(), block.begin(), block.end());
+      // No bound holds (a step that moves neighbouring triangles by more
+      // than many edge lengths relative to each other): every pair whose
+      // boxes swept from x to y come within d is tested.
+      buildSweptGrid();
+      m_NumberOfTestedTriangles = numberOfTriangles;
+      for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+      {
+        m_SweptGrid.ForEachOverlap(t, [&](SizeValueType u) {
+          if (u < t || SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
+          {
+            return;
+          }
+          if (this->Violates(t, u, x, y, d))
+          {
+            violating.emplace_back(static_cast<IndexType>(t), static_cast<IndexType>(u));
+          }
+        });
+      }
     }
 
     // Reduce the displacements of the violating pairs' points, test the
@@ -953,6 +982,7 @@ public:
     std::vector<IndexType> triangles;
     while (!violating.empty())
     {
+      buildSweptGrid();
       std::sort(violating.begin(), violating.end());
       violating.erase(std::unique(violating.begin(), violating.end()), violating.end());
       result.violations += violating.size();
@@ -996,7 +1026,7 @@ public:
       violating.clear();
       for (const IndexType t : triangles)
       {
-        m_Grid.ForEachOverlap(t, [&](SizeValueType u) {
+        m_SweptGrid.ForEachOverlap(t, [&](SizeValueType u) {
           if (SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
           {
             return;
@@ -1125,6 +1155,76 @@ public:
   }
 
 private:
+  /** Radius of the candidate pairs at a rebuild, in mean edge lengths
+   * (beyond the minimum distance). */
+  static constexpr double RadiusFactor = 0.75;
+
+  enum class BoundStatus
+  {
+    Bounded,
+    Exceeded,
+    NonFinite
+  };
+
+  /** One level of the pyramid of cells: the occupied cells (slots), sorted
+   * by key, the slot of the next level each belongs to, the occupied cells
+   * among the 27 around each (itself included), and per step the box of the
+   * displacements in each cell and the union over its neighbours. */
+  struct CellLevel
+  {
+    double                 cellSize{ 1.0 };
+    std::vector<uint64_t>  keys;
+    std::vector<IndexType> parents;
+    std::vector<IndexType> neighbourOffsets;
+    std::vector<IndexType> neighbours;
+    std::vector<float>     boxes;
+    std::vector<float>     unions;
+  };
+
+  static constexpr unsigned int KeyBits = 21;
+
+  static uint64_t
+  Key(uint64_t i, uint64_t j, uint64_t k)
+  {
+    return (i << (2 * KeyBits)) | (j << KeyBits) | k;
+  }
+
+  static void
+  EmptyBox(float * box)
+  {
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      box[k] = std::numeric_limits<float>::infinity();
+      box[3 + k] = -std::numeric_limits<float>::infinity();
+    }
+  }
+
+  static void
+  Unite(float * box, const float * other)
+  {
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      box[k] = std::min(box[k], other[k]);
+      box[3 + k] = std::max(box[3 + k], other[3 + k]);
+    }
+  }
+
+  /** Largest distance between a point of box a and a point of box b (boxes
+   * as lower x, y, z, upper x, y, z), widened by a relative 1e-9 to bound
+   * the rounding of the sum. */
+  static double
+  LargestDistance(const float * a, const float * b)
+  {
+    double sum = 0.0;
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      const double e = std::max(static_cast<double>(a[3 + k]) - static_cast<double>(b[k]),
+                                static_cast<double>(b[3 + k]) - static_cast<double>(a[k]));
+      sum += e * e;
+    }
+    return std::sqrt(sum) * (1.0 + 1e-9);
+  }
+
   static void
   TriangleBox(const double * x, const IndexType * v, double * lo, double * hi)
   {
@@ -1171,19 +1271,24 @@ private:
     return next < SurfaceCollisionDetail::TriangleDistance(a0, b0);
   }
 
-  /** Rebuilds the index at the reference positions x: the points' boxes
-   * from the proposed displacements y - x, motions |y - x|, clearances.
-   * False (and nothing built) when a coordinate is not finite. */
+  /** m as a float not above it. */
+  static float
+  RoundDown(double m)
+  {
+    const float f = static_cast<float>(m);
+    return static_cast<double>(f) <= m ? f : std::nextafter(f, -std::numeric_limits<float>::infinity());
+  }
+
+  /** Rebuilds the index at the reference positions x (see the class
+   * documentation), with the candidate radius d + RadiusFactor mean edge
+   * lengths. False (and nothing built) when a coordinate is not finite. */
   template <typename TParallel>
   bool
-  Build(const double *                                              x,
-        const double *                                              y,
-        double                                                      minimumDistance,
-        TParallel &&                                                parallel,
-        std::vector<std::vector<std::pair<IndexType, IndexType>>> & found)
+  Build(const double * x, double minimumDistance, TParallel && parallel)
   {
     const SizeValueType n = m_NumberOfPoints;
     const SizeValueType numberOfTriangles = this->GetNumberOfTriangles();
+    m_IndexValid = false;
     ++m_NumberOfRebuilds;
     m_MinimumDistance = minimumDistance;
     double edges = 0.0;
@@ -1198,31 +1303,297 @@ private:
       }
     }
     const double meanEdge = edges / static_cast<double>(3 * numberOfTriangles);
+    if (!std::isfinite(meanEdge))
+    {
+      return false;
+    }
     m_ContactDistance = 1e-6 * meanEdge;
     const double d = std::max(minimumDistance, m_ContactDistance);
-    const double baseSkin = 0.25 * meanEdge;
+    const double radius = d + RadiusFactor * std::max(meanEdge, m_ContactDistance);
+    m_Radius = radius;
     m_Reference.assign(x, x + 3 * n);
-    m_VertexBoxes.resize(6 * n);
-    std::atomic<bool> finite{ std::isfinite(meanEdge) };
+
+    // Bounding spheres; the largest radius.
+    m_Spheres.resize(4 * numberOfTriangles);
+    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+      for (SizeValueType t = begin; t < end; ++t)
+      {
+        Sphere(x, m_Triangles.data() + 3 * t, m_Spheres.data() + 4 * t);
+      }
+    });
+    double largestRadius = 0.0;
+    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+    {
+      largestRadius = std::max(largestRadius, m_Spheres[4 * t + 3]);
+    }
+    m_LargestTriangleRadius = largestRadius;
+
+    // Candidate pairs: boxes widened by R/2 that overlap, closer than R.
+    std::vector<float> boxes(6 * numberOfTriangles);
+    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+      for (SizeValueType t = begin; t < end; ++t)
+      {
+        double lo[3], hi[3];
+        TriangleBox(x, m_Triangles.data() + 3 * t, lo, hi);
+        SurfaceCollisionDetail::StoreBox(lo, hi, 0.5 * radius, boxes.data() + 6 * t);
+      }
+    });
+    SurfaceCollisionDetail::BoxGrid grid;
+    grid.Build(boxes.data(), numberOfTriangles);
+    struct Pair
+    {
+      IndexType t;
+      IndexType u;
+      float     gap;
+    };
+    const SizeValueType            blocks = (numberOfTriangles + 1023) / 1024;
+    std::vector<std::vector<Pair>> pairs(blocks);
+    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+      auto & out = pairs[begin / 1024];
+      for (SizeValueType t = begin; t < end; ++t)
+      {
+        const IndexType * vt = m_Triangles.data() + 3 * t;
+        const double *    st = m_Spheres.data() + 4 * t;
+        grid.ForEachOverlap(t, [&](SizeValueType u) {
+          const IndexType * vu = m_Triangles.data() + 3 * u;
+          if (u < t || SurfaceCollisionDetail::ShareVertex(vt, vu))
+          {
+            return;
+          }
+          const double * su = m_Spheres.data() + 4 * u;
+          double         e[3];
+          SurfaceCollisionDetail::Subtract(st, su, e);
+          if (std::sqrt(SurfaceCollisionDetail::Dot(e, e)) - st[3] - su[3] >= radius)
+          {
+            return;
+          }
+          const double * a[3] = { x + 3 * vt[0], x + 3 * vt[1], x + 3 * vt[2] };
+          const double * b[3] = { x + 3 * vu[0], x + 3 * vu[1], x + 3 * vu[2] };
+          const double   gap = SurfaceCollisionDetail::TriangleDistance(a, b);
+          if (gap < radius)
+          {
+            out.push_back({ static_cast<IndexType>(t), static_cast<IndexType>(u), RoundDown(gap) });
+          }
+        });
+      }
+    });
+    m_CandidateOffsets.assign(numberOfTriangles + 1, 0);
+    for (const auto & block : pairs)
+    {
+      for (const Pair & p : block)
+      {
+        ++m_CandidateOffsets[p.t + 1];
+        ++m_CandidateOffsets[p.u + 1];
+      }
+    }
+    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+    {
+      m_CandidateOffsets[t + 1] += m_CandidateOffsets[t];
+    }
+    m_Candidates.resize(m_CandidateOffsets[numberOfTriangles]);
+    m_CandidateGaps.resize(m_Candidates.size());
+    {
+      std::vector<SizeValueType> fill(m_CandidateOffsets.begin(), m_CandidateOffsets.end() - 1);
+      for (const auto & block : pairs)
+      {
+        for (const Pair & p : block)
+        {
+          m_Candidates[fill[p.t]] = p.u;
+          m_CandidateGaps[fill[p.t]++] = p.gap;
+          m_Candidates[fill[p.u]] = p.t;
+          m_CandidateGaps[fill[p.u]++] = p.gap;
+        }
+      }
+    }
+    m_Clearance.resize(numberOfTriangles);
+    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+      for (SizeValueType t = begin; t < end; ++t)
+      {
+        double smallest = radius;
+        for (SizeValueType c = m_CandidateOffsets[t]; c < m_CandidateOffsets[t + 1]; ++c)
+        {
+          smallest = std::min(smallest, static_cast<double>(m_CandidateGaps[c]));
+        }
+        m_Clearance[t] = RoundDown(smallest - d);
+      }
+    });
+
+    // The pyramid of cells. Level 0: cells of side R + 2 rmax (larger when
+    // the keys would not fit), each triangle in the cell of its centroid.
+    double lower[3] = { std::numeric_limits<double>::infinity(),
+                        std::numeric_limits<double>::infinity(),
+                        std::numeric_limits<double>::infinity() };
+    double upper[3] = { -std::numeric_limits<double>::infinity(),
+                        -std::numeric_limits<double>::infinity(),
+                        -std::numeric_limits<double>::infinity() };
+    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+    {
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        lower[k] = std::min(lower[k], m_Spheres[4 * t + k]);
+        upper[k] = std::max(upper[k], m_Spheres[4 * t + k]);
+      }
+    }
+    double cellSize = (radius + 2.0 * largestRadius) * (1.0 + 1e-9);
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      cellSize = std::max(cellSize, (upper[k] - lower[k]) / static_cast<double>((uint64_t{ 1 } << KeyBits) - 4));
+    }
+    if (!(cellSize > 0.0) || !std::isfinite(cellSize))
+    {
+      cellSize = 1.0; // a degenerate surface (every point at one place)
+    }
+    std::vector<uint64_t> coordinates(3 * numberOfTriangles);
+    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+    {
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        coordinates[3 * t + k] = static_cast<uint64_t>((m_Spheres[4 * t + k] - lower[k]) / cellSize) + 1;
+      }
+    }
+    m_CellOrder.resize(numberOfTriangles);
+    std::vector<uint64_t> keys(numberOfTriangles);
+    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+    {
+      keys[t] = Key(coordinates[3 * t], coordinates[3 * t + 1], coordinates[3 * t + 2]);
+      m_CellOrder[t] = static_cast<IndexType>(t);
+    }
+    std::sort(m_CellOrder.begin(), m_CellOrder.end(), [&keys](IndexType a, IndexType b) {
+      return keys[a] < keys[b] || (keys[a] == keys[b] && a < b);
+    });
+    m_Levels.clear();
+    m_Levels.emplace_back();
+    m_Levels[0].cellSize = cellSize;
+    m_CellOffsets.clear();
+    m_TriangleCell.resize(numberOfTriangles);
+    for (SizeValueType i = 0; i < numberOfTriangles; ++i)
+    {
+      const IndexType t = m_CellOrder[i];
+      if (m_Levels[0].keys.empty() || m_Levels[0].keys.back() != keys[t])
+      {
+        m_Levels[0].keys.push_back(keys[t]);
+        m_CellOffsets.push_back(static_cast<IndexType>(i));
+      }
+      m_TriangleCell[t] = static_cast<IndexType>(m_Levels[0].keys.size() - 1);
+    }
+    m_CellOffsets.push_back(static_cast<IndexType>(numberOfTriangles));
+    // Coarser levels until every cell neighbours every other.
+    const uint64_t mask = (uint64_t{ 1 } << KeyBits) - 1;
+    const auto     spread = [mask](const std::vector<uint64_t> & levelKeys) {
+      uint64_t largest = 0;
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        uint64_t lo = mask, hi = 0;
+        for (const uint64_t key : levelKeys)
+        {
+          const uint64_t c = (key >> (KeyBits * (2 - k))) & mask;
+          lo = std::min(lo, c);
+          hi = std::max(hi, c);
+        }
+        largest = std::max(largest, hi - lo);
+      }
+      return largest;
+    };
+    while (spread(m_Levels.back().keys) > 1)
+    {
+      CellLevel & finer = m_Levels.back();
+      CellLevel   coarser;
+      coarser.cellSize = 2.0 * finer.cellSize;
+      std::vector<uint64_t> parentKeys(finer.keys.size());
+      for (SizeValueType s = 0; s < finer.keys.size(); ++s)
+      {
+        const uint64_t key = finer.keys[s];
+        parentKeys[s] = Key(((key >> (2 * KeyBits)) & mask) >> 1, ((key >> KeyBits) & mask) >> 1, (key & mask) >> 1);
+      }
+      coarser.keys = parentKeys;
+      std::sort(coarser.keys.begin(), coarser.keys.end());
+      coarser.keys.erase(std::unique(coarser.keys.begin(), coarser.keys.end()), coarser.keys.end());
+      finer.parents.resize(finer.keys.size());
+      for (SizeValueType s = 0; s < finer.keys.size(); ++s)
+      {
+        finer.parents[s] = static_cast<IndexType>(
+          std::lower_bound(coarser.keys.begin(), coarser.keys.end(), parentKeys[s]) - coarser.keys.begin());
+      }
+      m_Levels.push_back(std::move(coarser));
+    }
+    for (CellLevel & level : m_Levels)
+    {
+      const SizeValueType cells = level.keys.size();
+      level.neighbourOffsets.assign(1, 0);
+      level.neighbours.clear();
+      for (SizeValueType s = 0; s < cells; ++s)
+      {
+        const uint64_t key = level.keys[s];
+        const uint64_t ci = (key >> (2 * KeyBits)) & mask;
+        const uint64_t cj = (key >> KeyBits) & mask;
+        const uint64_t ck = key & mask;
+        for (int di = -1; di <= 1; ++di)
+        {
+          for (int dj = -1; dj <= 1; ++dj)
+          {
+            for (int dk = -1; dk <= 1; ++dk)
+            {
+              // Level-0 coordinates start at 1; on coarser levels a
+              // coordinate 0 has no lower neighbour.
+              if ((ci == 0 && di < 0) || (cj == 0 && dj < 0) || (ck == 0 && dk < 0))
+              {
+                continue;
+              }
+              const uint64_t neighbour = Key(ci + di, cj + dj, ck + dk);
+              const auto     it = std::lower_bound(level.keys.begin(), level.keys.end(), neighbour);
+              if (it != level.keys.end() && *it == neighbour)
+              {
+                level.neighbours.push_back(static_cast<IndexType>(it - level.keys.begin()));
+              }
+            }
+          }
+        }
+        level.neighbourOffsets.push_back(static_cast<IndexType>(level.neighbours.size()));
+      }
+      level.boxes.resize(6 * cells);
+      level.unions.resize(6 * cells);
+    }
+    // Smallest clearance of each level-0 cell.
+    m_CellClearance.resize(m_Levels[0].keys.size());
+    for (SizeValueType s = 0; s < m_Levels[0].keys.size(); ++s)
+    {
+      float smallest = std::numeric_limits<float>::infinity();
+      for (IndexType i = m_CellOffsets[s]; i < m_CellOffsets[s + 1]; ++i)
+      {
+        smallest = std::min(smallest, m_Clearance[m_CellOrder[i]]);
+      }
+      m_CellClearance[s] = smallest;
+    }
+    m_VertexDelta.resize(6 * n);
+    m_TriangleDelta.resize(6 * numberOfTriangles);
+    m_Active.assign(numberOfTriangles, 0);
+    m_IndexValid = true;
+    return true;
+  }
+
+  /** The bounds of the class documentation at the proposed positions y:
+   * Exceeded when a level's bound or some triangle's rho reaches R - d
+   * (the index must be rebuilt), otherwise m_Active marks the triangles
+   * whose rho reaches their clearance. */
+  template <typename TParallel>
+  BoundStatus
+  Bound(const double * y, TParallel && parallel)
+  {
+    const SizeValueType n = m_NumberOfPoints;
+    const double        d = std::max(m_MinimumDistance, m_ContactDistance);
+    std::atomic<bool>   finite{ true };
     parallel(n, [&](SizeValueType begin, SizeValueType end) {
       bool blockFinite = true;
       for (SizeValueType i = begin; i < end; ++i)
       {
-        double e[3];
-        SurfaceCollisionDetail::Subtract(y + 3 * i, x + 3 * i, e);
-        const double m = std::sqrt(SurfaceCollisionDetail::Dot(e, e));
-        blockFinite = blockFinite && std::isfinite(m);
-        m_Motion[i] = RoundUp(m);
-        // The box swept by this step and one more of the same displacement,
-        // widened by the base skin.
-        double lo[3], hi[3];
+        float * box = m_VertexDelta.data() + 6 * i;
         for (unsigned int k = 0; k < 3; ++k)
         {
-          const double ahead = x[3 * i + k] + 2.0 * e[k];
-          lo[k] = std::min(x[3 * i + k], ahead);
-          hi[k] = std::max(x[3 * i + k], ahead);
+          const double delta = y[3 * i + k] - m_Reference[3 * i + k];
+          blockFinite = blockFinite && std::isfinite(delta);
+          box[k] = RoundDown(delta);
+          box[3 + k] = RoundUp(delta);
         }
-        SurfaceCollisionDetail::StoreBox(lo, hi, baseSkin, m_VertexBoxes.data() + 6 * i);
       }
       if (!blockFinite)
       {
@@ -1231,77 +1602,127 @@ private:
     });
     if (!finite)
     {
-      m_IndexValid = false;
-      return false;
+      return BoundStatus::NonFinite;
     }
-    m_Boxes.resize(6 * numberOfTriangles);
-    m_TriangleMotion.resize(numberOfTriangles);
-    m_Active.assign(numberOfTriangles, 0);
+    // Triangles' and level-0 cells' boxes.
+    CellLevel &         base = m_Levels[0];
+    const SizeValueType baseCells = base.keys.size();
+    parallel(baseCells, [&](SizeValueType begin, SizeValueType end) {
+      for (SizeValueType s = begin; s < end; ++s)
+      {
+        float * cellBox = base.boxes.data() + 6 * s;
+        EmptyBox(cellBox);
+        for (IndexType i = m_CellOffsets[s]; i < m_CellOffsets[s + 1]; ++i)
+        {
+          const IndexType   t = m_CellOrder[i];
+          const IndexType * v = m_Triangles.data() + 3 * t;
+          float *           box = m_TriangleDelta.data() + 6 * t;
+          std::copy(m_VertexDelta.data() + 6 * v[0], m_VertexDelta.data() + 6 * v[0] + 6, box);
+          Unite(box, m_VertexDelta.data() + 6 * v[1]);
+          Unite(box, m_VertexDelta.data() + 6 * v[2]);
+          Unite(cellBox, box);
+        }
+      }
+    });
+    for (SizeValueType l = 1; l < m_Levels.size(); ++l)
+    {
+      CellLevel &       level = m_Levels[l];
+      const CellLevel & finer = m_Levels[l - 1];
+      for (SizeValueType s = 0; s < level.keys.size(); ++s)
+      {
+        EmptyBox(level.boxes.data() + 6 * s);
+      }
+      for (SizeValueType s = 0; s < finer.keys.size(); ++s)
+      {
+        Unite(level.boxes.data() + 6 * finer.parents[s], finer.boxes.data() + 6 * s);
+      }
+    }
+    std::atomic<bool> exceeded{ false };
+    for (SizeValueType l = 0; l < m_Levels.size(); ++l)
+    {
+      CellLevel & level = m_Levels[l];
+      // Pairs first met at this level are at least 2^(l-1) s - 2 rmax apart.
+      const double limit = l == 0 ? 0.0 : m_Levels[l - 1].cellSize - 2.0 * m_LargestTriangleRadius * (1.0 + 1e-9) - d;
+      parallel(level.keys.size(), [&](SizeValueType begin, SizeValueType end) {
+        bool out = false;
+        for (SizeValueType s = begin; s < end; ++s)
+        {
+          float * u = level.unions.data() + 6 * s;
+          EmptyBox(u);
+          for (IndexType c = level.neighbourOffsets[s]; c < level.neighbourOffsets[s + 1]; ++c)
+          {
+            Unite(u, level.boxes.data() + 6 * level.neighbours[c]);
+          }
+          if (l > 0 && !(LargestDistance(level.boxes.data() + 6 * s, u) < limit))
+          {
+            out = true;
+          }
+        }
+        if (out)
+        {
+          exceeded = true;
+        }
+      });
+      if (exceeded)
+      {
+        return BoundStatus::Exceeded;
+      }
+    }
+    // Level 0: rho of each triangle against its cell's neighbourhood.
+    const double radiusLimit = m_Radius - d;
+    parallel(baseCells, [&](SizeValueType begin, SizeValueType end) {
+      bool out = false;
+      for (SizeValueType s = begin; s < end; ++s)
+      {
+        const float * u = base.unions.data() + 6 * s;
+        const double  cellRho = LargestDistance(base.boxes.data() + 6 * s, u);
+        const bool    cellClear = cellRho < static_cast<double>(m_CellClearance[s]);
+        const bool    cellInside = cellRho < radiusLimit;
+        for (IndexType i = m_CellOffsets[s]; i < m_CellOffsets[s + 1]; ++i)
+        {
+          const IndexType t = m_CellOrder[i];
+          if (cellClear)
+          {
+            m_Active[t] = 0;
+            continue;
+          }
+          const double rho = LargestDistance(m_TriangleDelta.data() + 6 * t, u);
+          out = out || (!cellInside && !(rho < radiusLimit));
+          m_Active[t] = rho < static_cast<double>(m_Clearance[t]) ? 0 : 1;
+        }
+      }
+      if (out)
+      {
+        exceeded = true;
+      }
+    });
+    return exceeded ? BoundStatus::Exceeded : BoundStatus::Bounded;
+  }
+
+  /** The uniform grid of the triangles' boxes swept from x to y, widened by
+   * d/2: two triangles whose boxes do not overlap are at least d apart in
+   * every state between x and y that the reductions make. */
+  template <typename TParallel>
+  void
+  BuildSweptGrid(const double * x, const double * y, double d, TParallel && parallel)
+  {
+    const SizeValueType numberOfTriangles = this->GetNumberOfTriangles();
+    m_SweptBoxes.resize(6 * numberOfTriangles);
     parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
       for (SizeValueType t = begin; t < end; ++t)
       {
-        const IndexType * v = m_Triangles.data() + 3 * t;
-        m_TriangleMotion[t] = std::max({ m_Motion[v[0]], m_Motion[v[1]], m_Motion[v[2]] });
-        double lo[3], hi[3];
+        double lo[3], hi[3], lo2[3], hi2[3];
+        TriangleBox(x, m_Triangles.data() + 3 * t, lo, hi);
+        TriangleBox(y, m_Triangles.data() + 3 * t, lo2, hi2);
         for (unsigned int k = 0; k < 3; ++k)
         {
-          lo[k] = std::min({ m_VertexBoxes[6 * v[0] + k], m_VertexBoxes[6 * v[1] + k], m_VertexBoxes[6 * v[2] + k] });
-          hi[k] = std::max(
-            { m_VertexBoxes[6 * v[0] + 3 + k], m_VertexBoxes[6 * v[1] + 3 + k], m_VertexBoxes[6 * v[2] + 3 + k] });
+          lo[k] = std::min(lo[k], lo2[k]);
+          hi[k] = std::max(hi[k], hi2[k]);
         }
-        SurfaceCollisionDetail::StoreBox(lo, hi, 0.5 * d, m_Boxes.data() + 6 * t);
+        SurfaceCollisionDetail::StoreBox(lo, hi, 0.5 * d, m_SweptBoxes.data() + 6 * t);
       }
     });
-    m_Grid.Build(m_Boxes.data(), numberOfTriangles);
-
-    // Clearances: lower bounds, at x, of the distances to the triangles
-    // whose boxes overlap, less d: bounding spheres (centroid, largest
-    // distance to a vertex), the exact distance where the spheres' gap less
-    // d is below the base skin.
-    m_Clearance.resize(numberOfTriangles);
-    m_Spheres.resize(4 * numberOfTriangles);
-    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
-      for (SizeValueType t = begin; t < end; ++t)
-      {
-        Sphere(x, m_Triangles.data() + 3 * t, m_Spheres.data() + 4 * t);
-      }
-    });
-    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
-      auto & out = found[begin / 4096];
-      for (SizeValueType t = begin; t < end; ++t)
-      {
-        const IndexType * vt = m_Triangles.data() + 3 * t;
-        const double *    st = m_Spheres.data() + 4 * t;
-        double            clearance = std::numeric_limits<double>::infinity();
-        m_Grid.ForEachOverlap(t, [&](SizeValueType u) {
-          const IndexType * vu = m_Triangles.data() + 3 * u;
-          if (SurfaceCollisionDetail::ShareVertex(vt, vu))
-          {
-            return;
-          }
-          const double * su = m_Spheres.data() + 4 * u;
-          double         e[3];
-          SurfaceCollisionDetail::Subtract(st, su, e);
-          double bound = std::sqrt(SurfaceCollisionDetail::Dot(e, e)) - st[3] - su[3];
-          if (bound - d < baseSkin)
-          {
-            const double * a[3] = { x + 3 * vt[0], x + 3 * vt[1], x + 3 * vt[2] };
-            const double * b[3] = { x + 3 * vu[0], x + 3 * vu[1], x + 3 * vu[2] };
-            bound = std::max(bound, SurfaceCollisionDetail::TriangleDistance(a, b));
-          }
-          clearance = std::min(clearance, bound - d);
-          if (t < u &&
-              bound - d <= static_cast<double>(m_TriangleMotion[t]) + static_cast<double>(m_TriangleMotion[u]) &&
-              this->Violates(t, u, x, y, d))
-          {
-            out.emplace_back(static_cast<IndexType>(t), static_cast<IndexType>(u));
-          }
-        });
-        m_Clearance[t] = clearance;
-      }
-    });
-    m_IndexValid = true;
-    return true;
+    m_SweptGrid.Build(m_SweptBoxes.data(), numberOfTriangles);
   }
 
   /** m as a float not below it (0 stays 0). */
@@ -1338,25 +1759,34 @@ private:
   std::vector<SizeValueType> m_VertexTriangleOffsets;
   std::vector<IndexType>     m_VertexTriangles;
 
-  // The index: reference positions, points' and triangles' boxes, grid,
-  // clearances.
-  bool                            m_IndexValid{ false };
-  double                          m_MinimumDistance{ 0.0 };
-  double                          m_ContactDistance{ 0.0 };
-  SizeValueType                   m_NumberOfRebuilds{ 0 };
-  std::vector<double>             m_Reference;
-  std::vector<float>              m_VertexBoxes; // per point: the box it may move in
-  std::vector<double>             m_Spheres;     // per triangle at the reference: centre, radius
-  std::vector<float>              m_Boxes;
-  std::vector<double>             m_Clearance;
-  SurfaceCollisionDetail::BoxGrid m_Grid;
+  // The index (see the class documentation).
+  bool                   m_IndexValid{ false };
+  double                 m_MinimumDistance{ 0.0 };
+  double                 m_ContactDistance{ 0.0 };
+  double                 m_Radius{ 0.0 };
+  double                 m_LargestTriangleRadius{ 0.0 };
+  SizeValueType          m_NumberOfRebuilds{ 0 };
+  std::vector<double>    m_Reference;
+  std::vector<double>    m_Spheres; // per triangle at the reference: centre, radius
+  std::vector<IndexType> m_CandidateOffsets;
+  std::vector<IndexType> m_Candidates;    // both directions
+  std::vector<float>     m_CandidateGaps; // distance at the reference, rounded down
+  std::vector<float>     m_Clearance;     // per triangle
+  std::vector<CellLevel> m_Levels;
+  std::vector<IndexType> m_CellOrder;   // triangles sorted by level-0 cell
+  std::vector<IndexType> m_CellOffsets; // level-0 cell -> range of m_CellOrder
+  std::vector<IndexType> m_TriangleCell;
+  std::vector<float>     m_CellClearance;
 
   // Per step.
-  std::vector<float>     m_Motion;
-  std::vector<uint8_t>   m_Active;
-  std::vector<float>     m_TriangleMotion; // largest motion of its points
-  std::vector<uint8_t>   m_Level;
-  std::vector<IndexType> m_ModifiedPoints;
+  std::vector<float>              m_VertexDelta;   // per point: y - r, as a box rounded outward
+  std::vector<float>              m_TriangleDelta; // per triangle: box of its points' y - r
+  std::vector<uint8_t>            m_Active;
+  SizeValueType                   m_NumberOfTestedTriangles{ 0 };
+  std::vector<float>              m_SweptBoxes;
+  SurfaceCollisionDetail::BoxGrid m_SweptGrid;
+  std::vector<uint8_t>            m_Level;
+  std::vector<IndexType>          m_ModifiedPoints;
 };
 } // end namespace itk
 

@@ -519,6 +519,97 @@ TEST(SurfaceCollision, ConstrainStopsFrontsPushedThroughEachOther)
   EXPECT_GE(second.smallestDistance, d);
 }
 
+TEST(SurfaceCollision, RandomStepsNeverBringPairsCloserThanD)
+{
+  // Two parallel sheets 1 apart (edges 0.5), 80 steps of random smooth
+  // displacements that push them through each other and back, with a
+  // tangential wave and every fifth and sixth step a translation of the whole
+  // surface by 1.9 (four times the index's radius). After every Constrain():
+  // no intersecting pair and no pair closer than d, by this file's all-pairs
+  // test. A translation moves no triangle relative to another: the second of
+  // two translations keeps the index (the first may follow a rebuild).
+  const unsigned int    m = 12;
+  std::vector<double>   x;
+  std::vector<uint32_t> triangles;
+  for (unsigned int sheet = 0; sheet < 2; ++sheet)
+  {
+    const auto base = static_cast<uint32_t>(x.size() / 3);
+    for (unsigned int j = 0; j <= m; ++j)
+    {
+      for (unsigned int i = 0; i <= m; ++i)
+      {
+        x.push_back(0.5 * i + (sheet ? 0.13 : 0.0));
+        x.push_back(0.5 * j + (sheet ? 0.07 : 0.0));
+        x.push_back(sheet ? 1.0 : 0.0);
+      }
+    }
+    for (unsigned int j = 0; j < m; ++j)
+    {
+      for (unsigned int i = 0; i < m; ++i)
+      {
+        const uint32_t p = base + j * (m + 1) + i;
+        triangles.insert(triangles.end(), { p, p + 1, p + m + 2, p, p + m + 2, p + m + 1 });
+      }
+    }
+  }
+  const std::size_t n = x.size() / 3;
+  const double      d = 0.1;
+  ASSERT_GE(CheckAllPairs(x, triangles, d).smallestDistance, d);
+  itk::SurfaceCollision collision;
+  collision.SetSurface(n, triangles.data(), triangles.size() / 3);
+  std::mt19937                           random(20261202);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  unsigned int                           constrainedSteps = 0;
+  unsigned int                           keptIndex = 0;
+  unsigned int                           secondTranslations = 0;
+  unsigned int                           secondTranslationRebuilds = 0;
+  for (unsigned int step = 0; step < 80; ++step)
+  {
+    std::vector<double> y = x;
+    const bool          translation = step % 6 == 4 || step % 6 == 5;
+    if (translation)
+    {
+      for (std::size_t i = 0; i < n; ++i)
+      {
+        y[3 * i] += 1.5;
+        y[3 * i + 1] -= 0.7;
+        y[3 * i + 2] += 0.9;
+      }
+    }
+    else
+    {
+      const double amplitude = -0.2 + 0.6 * uniform(random);
+      const double cx = x[0] + 6.0 * uniform(random);
+      const double cy = x[1] + 6.0 * uniform(random);
+      const double phase = 6.28 * uniform(random);
+      for (std::size_t i = 0; i < n; ++i)
+      {
+        const double px = x[3 * i] - cx, py = x[3 * i + 1] - cy;
+        const double bump = amplitude * std::exp(-(px * px + py * py) / 4.0);
+        y[3 * i] += 0.05 * std::sin(1.3 * x[3 * i + 1] + phase);
+        y[3 * i + 1] += 0.05 * std::cos(0.9 * x[3 * i] + phase);
+        y[3 * i + 2] += i >= n / 2 ? -bump : bump;
+      }
+    }
+    const auto       result = collision.Constrain(x.data(), y.data(), d, nullptr, 1);
+    const BruteForce check = CheckAllPairs(y, triangles, d);
+    ASSERT_EQ(check.intersecting, 0u) << "step " << step;
+    ASSERT_GE(check.smallestDistance, d - 1e-9) << "step " << step;
+    constrainedSteps += result.constrained > 0 ? 1 : 0;
+    keptIndex += result.rebuilt ? 0 : 1;
+    if (step % 6 == 5)
+    {
+      ++secondTranslations;
+      secondTranslationRebuilds += result.rebuilt ? 1 : 0;
+    }
+    x = y;
+  }
+  EXPECT_GE(constrainedSteps, 10u) << "the sheets were pushed into each other";
+  EXPECT_GE(keptIndex, 20u) << "the index served several steps";
+  EXPECT_EQ(secondTranslationRebuilds, 0u) << "of " << secondTranslations << " second translations";
+  std::cout << constrainedSteps << " steps constrained, the index kept at " << keptIndex << " of 80 steps" << std::endl;
+}
+
 // ---------------------------------------------------------------------------
 // DeformableMeshFilter with PreventSelfIntersections.
 namespace
