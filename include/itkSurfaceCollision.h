@@ -520,9 +520,33 @@ public:
   void
   ForEachOverlap(SizeValueType t, TFunction && f) const
   {
-    const float * a = m_Boxes + 6 * t;
-    int64_t       lo[3], hi[3];
+    this->ForEachOverlapOfBox(m_Boxes + 6 * t, t, f);
+  }
+
+  /** Calls f(u) for every box u != skip that overlaps the box \a query
+   * (lower x, y, z, upper x, y, z; any box, also one reaching below the
+   * grid's origin), once each. */
+  template <typename TFunction>
+  void
+  ForEachOverlapOfBox(const float * query, SizeValueType skip, TFunction && f) const
+  {
+    if (m_Entries.empty())
+    {
+      return;
+    }
+    float a[6];
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      a[k] = std::max(query[k], static_cast<float>(m_Origin[k]));
+      a[3 + k] = query[3 + k];
+      if (!(a[k] <= a[3 + k]))
+      {
+        return; // entirely below the origin: no box there
+      }
+    }
+    int64_t lo[3], hi[3];
     this->CellRange(a, lo, hi);
+    const SizeValueType t = skip;
     for (int64_t k = lo[2]; k <= hi[2]; ++k)
     {
       for (int64_t j = lo[1]; j <= hi[1]; ++j)
@@ -671,11 +695,16 @@ StoreBox(const double * lower, const double * upper, double margin, float * box)
  *   (rounded down); every other pair is at least R apart at r. Each
  *   triangle's clearance is the smallest distance of its candidates, at most
  *   R, less d;
- * - a pyramid of cells: level 0 has cells of side s = R + 2 rmax (rmax the
- *   largest distance from a triangle's centroid to its vertices), each
- *   triangle in the cell of its centroid, so that every candidate of a
- *   triangle is in one of the 27 cells around its own; level k has cells of
- *   side 2^k s; the top level has at most two cells along each axis.
+ * - a pyramid of cells: level 0 has cells of side s = R + 2 r99 (r99 the
+ *   99th percentile of the triangles' radii, the largest distance from a
+ *   triangle's centroid to its vertices), each triangle in the cell of its
+ *   centroid, so that every candidate of a triangle of radius up to r99 is
+ *   in one of the 27 cells around its own; level k has cells of side
+ *   2^k s; the top level has at most two cells along each axis. The larger
+ *   triangles (1 %, "large triangles") are in no cell: at every step each
+ *   is tested against the triangles whose boxes at r come within d plus the
+ *   largest distance between its displacement box and the box of all
+ *   displacements (a grid of the boxes at r).
  * At each step the displacement y - r of every vertex is taken, and for
  * every triangle the box of its vertices' displacements; the box of a cell
  * is the union of its triangles', and its neighbourhood box the union over
@@ -684,9 +713,11 @@ StoreBox(const double * lower, const double * upper, double margin, float * box)
  * one of u's (the points of a triangle are convex combinations of its
  * vertices). Hence, with the distance d(t, u) at r:
  * - a pair whose level-k cells are neighbours but whose level-(k-1) cells
- *   are not is at least 2^(k-1) s - 2 rmax apart at r: such pairs are clear
- *   when, for every level-k cell, the largest distance between its box and
- *   its neighbourhood box is below 2^(k-1) s - 2 rmax - d;
+ *   are not is at least 2^(k-1) s - r_t - r_u apart at r (r_t, r_u the
+ *   triangles' radii): such pairs are clear when, for every level-k cell,
+ *   the largest distance between its box and its neighbourhood box is below
+ *   2^(k-1) s less the largest radius in the cell, less the largest in the
+ *   27 cells around it, less d;
  * - a pair of neighbouring level-0 cells is clear when the largest distance
  *   rho_t between t's box and the neighbourhood box of its cell is below
  *   d(t, u) - d: below R - d for the pairs that are not candidates, below
@@ -953,6 +984,41 @@ public:
         m_NumberOfTestedTriangles += tested[b];
         violating.insert(violating.end(), found[b].begin(), found[b].end());
       }
+      // The large triangles (in no cell), at every step, against every
+      // triangle that may have come within d: a pair closer than d at y is
+      // closer than d + the largest distance between t's displacement box
+      // and the box of all displacements at the reference.
+      m_NumberOfTestedTriangles += m_Large.size();
+      for (const IndexType t : m_Large)
+      {
+        const float * bt = m_TriangleDelta.data() + 6 * t;
+        const double  reach = LargestDistance(bt, m_GlobalDelta) + d;
+        double        lo[3], hi[3];
+        TriangleBox(m_Reference.data(), m_Triangles.data() + 3 * t, lo, hi);
+        float query[6];
+        SurfaceCollisionDetail::StoreBox(lo, hi, reach, query);
+        const double * st = m_Spheres.data() + 4 * t;
+        m_ReferenceGrid.ForEachOverlapOfBox(query, t, [&](SizeValueType u) {
+          if ((m_IsLarge[u] && u < t) ||
+              SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
+          {
+            return;
+          }
+          const double * su = m_Spheres.data() + 4 * u;
+          double         e[3];
+          SurfaceCollisionDetail::Subtract(st, su, e);
+          const double gap = std::sqrt(SurfaceCollisionDetail::Dot(e, e)) - st[3] - su[3];
+          if (LargestDistance(bt, m_TriangleDelta.data() + 6 * u) < gap - d)
+          {
+            return;
+          }
+          if (this->Violates(t, u, x, y, d))
+          {
+            violating.emplace_back(static_cast<IndexType>(std::min<SizeValueType>(t, u)),
+                                   static_cast<IndexType>(std::max<SizeValueType>(t, u)));
+          }
+        });
+      }
     }
     else
     {
@@ -1177,6 +1243,8 @@ private:
     std::vector<IndexType> parents;
     std::vector<IndexType> neighbourOffsets;
     std::vector<IndexType> neighbours;
+    std::vector<double>    radii;          // largest triangle radius in the cell
+    std::vector<double>    neighbourRadii; // the same over the 27 cells around
     std::vector<float>     boxes;
     std::vector<float>     unions;
   };
@@ -1321,15 +1389,35 @@ private:
         Sphere(x, m_Triangles.data() + 3 * t, m_Spheres.data() + 4 * t);
       }
     });
-    double largestRadius = 0.0;
+    // The cells are sized for the triangles up to the 99th percentile of
+    // the radii; the larger ("large triangles") are tested at every step.
+    double typicalRadius = 0.0;
+    {
+      std::vector<double> radii(numberOfTriangles);
+      for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+      {
+        radii[t] = m_Spheres[4 * t + 3];
+      }
+      const auto q = radii.begin() + static_cast<std::ptrdiff_t>((99 * (numberOfTriangles - 1)) / 100);
+      std::nth_element(radii.begin(), q, radii.end());
+      typicalRadius = *q;
+    }
+
+    m_Large.clear();
+    m_IsLarge.assign(numberOfTriangles, 0);
     for (SizeValueType t = 0; t < numberOfTriangles; ++t)
     {
-      largestRadius = std::max(largestRadius, m_Spheres[4 * t + 3]);
+      if (m_Spheres[4 * t + 3] > typicalRadius)
+      {
+        m_Large.push_back(static_cast<IndexType>(t));
+        m_IsLarge[t] = 1;
+      }
     }
-    m_LargestTriangleRadius = largestRadius;
 
     // Candidate pairs: boxes widened by R/2 that overlap, closer than R.
-    std::vector<float> boxes(6 * numberOfTriangles);
+    // The grid is kept for the large triangles' queries.
+    std::vector<float> & boxes = m_ReferenceBoxes;
+    boxes.resize(6 * numberOfTriangles);
     parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
       for (SizeValueType t = begin; t < end; ++t)
       {
@@ -1338,7 +1426,7 @@ private:
         SurfaceCollisionDetail::StoreBox(lo, hi, 0.5 * radius, boxes.data() + 6 * t);
       }
     });
-    SurfaceCollisionDetail::BoxGrid grid;
+    SurfaceCollisionDetail::BoxGrid & grid = m_ReferenceGrid;
     grid.Build(boxes.data(), numberOfTriangles);
     struct Pair
     {
@@ -1418,8 +1506,9 @@ private:
       }
     });
 
-    // The pyramid of cells. Level 0: cells of side R + 2 rmax (larger when
-    // the keys would not fit), each triangle in the cell of its centroid.
+    // The pyramid of cells. Level 0: cells of side R + 2 r99 (larger when
+    // the keys would not fit), each triangle in the cell of its centroid;
+    // the large triangles are in no cell.
     double lower[3] = { std::numeric_limits<double>::infinity(),
                         std::numeric_limits<double>::infinity(),
                         std::numeric_limits<double>::infinity() };
@@ -1434,7 +1523,7 @@ private:
         upper[k] = std::max(upper[k], m_Spheres[4 * t + k]);
       }
     }
-    double cellSize = (radius + 2.0 * largestRadius) * (1.0 + 1e-9);
+    double cellSize = (radius + 2.0 * typicalRadius) * (1.0 + 1e-9);
     for (unsigned int k = 0; k < 3; ++k)
     {
       cellSize = std::max(cellSize, (upper[k] - lower[k]) / static_cast<double>((uint64_t{ 1 } << KeyBits) - 4));
@@ -1451,12 +1540,15 @@ private:
         coordinates[3 * t + k] = static_cast<uint64_t>((m_Spheres[4 * t + k] - lower[k]) / cellSize) + 1;
       }
     }
-    m_CellOrder.resize(numberOfTriangles);
+    m_CellOrder.clear();
     std::vector<uint64_t> keys(numberOfTriangles);
     for (SizeValueType t = 0; t < numberOfTriangles; ++t)
     {
       keys[t] = Key(coordinates[3 * t], coordinates[3 * t + 1], coordinates[3 * t + 2]);
-      m_CellOrder[t] = static_cast<IndexType>(t);
+      if (!m_IsLarge[t])
+      {
+        m_CellOrder.push_back(static_cast<IndexType>(t));
+      }
     }
     std::sort(m_CellOrder.begin(), m_CellOrder.end(), [&keys](IndexType a, IndexType b) {
       return keys[a] < keys[b] || (keys[a] == keys[b] && a < b);
@@ -1465,8 +1557,8 @@ private:
     m_Levels.emplace_back();
     m_Levels[0].cellSize = cellSize;
     m_CellOffsets.clear();
-    m_TriangleCell.resize(numberOfTriangles);
-    for (SizeValueType i = 0; i < numberOfTriangles; ++i)
+    m_TriangleCell.assign(numberOfTriangles, std::numeric_limits<IndexType>::max());
+    for (SizeValueType i = 0; i < m_CellOrder.size(); ++i)
     {
       const IndexType t = m_CellOrder[i];
       if (m_Levels[0].keys.empty() || m_Levels[0].keys.back() != keys[t])
@@ -1476,7 +1568,7 @@ private:
       }
       m_TriangleCell[t] = static_cast<IndexType>(m_Levels[0].keys.size() - 1);
     }
-    m_CellOffsets.push_back(static_cast<IndexType>(numberOfTriangles));
+    m_CellOffsets.push_back(static_cast<IndexType>(m_CellOrder.size()));
     // Coarser levels until every cell neighbours every other.
     const uint64_t mask = (uint64_t{ 1 } << KeyBits) - 1;
     const auto     spread = [mask](const std::vector<uint64_t> & levelKeys) {
@@ -1553,6 +1645,34 @@ private:
       level.boxes.resize(6 * cells);
       level.unions.resize(6 * cells);
     }
+    // The largest triangle radius of each cell and of the 27 around it.
+    m_Levels[0].radii.assign(m_Levels[0].keys.size(), 0.0);
+    for (const IndexType t : m_CellOrder)
+    {
+      double & r = m_Levels[0].radii[m_TriangleCell[t]];
+      r = std::max(r, m_Spheres[4 * t + 3]);
+    }
+    for (SizeValueType l = 1; l < m_Levels.size(); ++l)
+    {
+      const CellLevel & finer = m_Levels[l - 1];
+      m_Levels[l].radii.assign(m_Levels[l].keys.size(), 0.0);
+      for (SizeValueType c = 0; c < finer.keys.size(); ++c)
+      {
+        double & r = m_Levels[l].radii[finer.parents[c]];
+        r = std::max(r, finer.radii[c]);
+      }
+    }
+    for (CellLevel & level : m_Levels)
+    {
+      level.neighbourRadii.assign(level.keys.size(), 0.0);
+      for (SizeValueType c = 0; c < level.keys.size(); ++c)
+      {
+        for (IndexType k = level.neighbourOffsets[c]; k < level.neighbourOffsets[c + 1]; ++k)
+        {
+          level.neighbourRadii[c] = std::max(level.neighbourRadii[c], level.radii[level.neighbours[k]]);
+        }
+      }
+    }
     // Smallest clearance of each level-0 cell.
     m_CellClearance.resize(m_Levels[0].keys.size());
     for (SizeValueType s = 0; s < m_Levels[0].keys.size(); ++s)
@@ -1624,6 +1744,17 @@ private:
         }
       }
     });
+    // The large triangles' boxes, and the box of every displacement.
+    EmptyBox(m_GlobalDelta);
+    for (const IndexType t : m_Large)
+    {
+      const IndexType * v = m_Triangles.data() + 3 * t;
+      float *           box = m_TriangleDelta.data() + 6 * t;
+      std::copy(m_VertexDelta.data() + 6 * v[0], m_VertexDelta.data() + 6 * v[0] + 6, box);
+      Unite(box, m_VertexDelta.data() + 6 * v[1]);
+      Unite(box, m_VertexDelta.data() + 6 * v[2]);
+      Unite(m_GlobalDelta, box);
+    }
     for (SizeValueType l = 1; l < m_Levels.size(); ++l)
     {
       CellLevel &       level = m_Levels[l];
@@ -1641,8 +1772,9 @@ private:
     for (SizeValueType l = 0; l < m_Levels.size(); ++l)
     {
       CellLevel & level = m_Levels[l];
-      // Pairs first met at this level are at least 2^(l-1) s - 2 rmax apart.
-      const double limit = l == 0 ? 0.0 : m_Levels[l - 1].cellSize - 2.0 * m_LargestTriangleRadius * (1.0 + 1e-9) - d;
+      // Pairs first met at this level are at least 2^(l-1) s less their
+      // triangles' radii apart.
+      const double separation = l == 0 ? 0.0 : m_Levels[l - 1].cellSize;
       parallel(level.keys.size(), [&](SizeValueType begin, SizeValueType end) {
         bool out = false;
         for (SizeValueType s = begin; s < end; ++s)
@@ -1653,7 +1785,8 @@ private:
           {
             Unite(u, level.boxes.data() + 6 * level.neighbours[c]);
           }
-          if (l > 0 && !(LargestDistance(level.boxes.data() + 6 * s, u) < limit))
+          if (l > 0 && !(LargestDistance(level.boxes.data() + 6 * s, u) <
+                         separation - (level.radii[s] + level.neighbourRadii[s]) * (1.0 + 1e-9) - d))
           {
             out = true;
           }
@@ -1667,6 +1800,11 @@ private:
       {
         return BoundStatus::Exceeded;
       }
+    }
+    const CellLevel & top = m_Levels.back();
+    for (SizeValueType c = 0; c < top.keys.size(); ++c)
+    {
+      Unite(m_GlobalDelta, top.boxes.data() + 6 * c);
     }
     // Level 0: rho of each triangle against its cell's neighbourhood.
     const double radiusLimit = m_Radius - d;
@@ -1760,28 +1898,32 @@ private:
   std::vector<IndexType>     m_VertexTriangles;
 
   // The index (see the class documentation).
-  bool                   m_IndexValid{ false };
-  double                 m_MinimumDistance{ 0.0 };
-  double                 m_ContactDistance{ 0.0 };
-  double                 m_Radius{ 0.0 };
-  double                 m_LargestTriangleRadius{ 0.0 };
-  SizeValueType          m_NumberOfRebuilds{ 0 };
-  std::vector<double>    m_Reference;
-  std::vector<double>    m_Spheres; // per triangle at the reference: centre, radius
-  std::vector<IndexType> m_CandidateOffsets;
-  std::vector<IndexType> m_Candidates;    // both directions
-  std::vector<float>     m_CandidateGaps; // distance at the reference, rounded down
-  std::vector<float>     m_Clearance;     // per triangle
-  std::vector<CellLevel> m_Levels;
-  std::vector<IndexType> m_CellOrder;   // triangles sorted by level-0 cell
-  std::vector<IndexType> m_CellOffsets; // level-0 cell -> range of m_CellOrder
-  std::vector<IndexType> m_TriangleCell;
-  std::vector<float>     m_CellClearance;
+  bool                            m_IndexValid{ false };
+  double                          m_MinimumDistance{ 0.0 };
+  double                          m_ContactDistance{ 0.0 };
+  double                          m_Radius{ 0.0 };
+  SizeValueType                   m_NumberOfRebuilds{ 0 };
+  std::vector<double>             m_Reference;
+  std::vector<double>             m_Spheres; // per triangle at the reference: centre, radius
+  std::vector<IndexType>          m_CandidateOffsets;
+  std::vector<IndexType>          m_Candidates;    // both directions
+  std::vector<float>              m_CandidateGaps; // distance at the reference, rounded down
+  std::vector<float>              m_Clearance;     // per triangle
+  std::vector<CellLevel>          m_Levels;
+  std::vector<IndexType>          m_CellOrder;   // triangles sorted by level-0 cell
+  std::vector<IndexType>          m_CellOffsets; // level-0 cell -> range of m_CellOrder
+  std::vector<IndexType>          m_TriangleCell;
+  std::vector<IndexType>          m_Large;          // triangles larger than the cells are made for
+  std::vector<uint8_t>            m_IsLarge;        // per triangle
+  std::vector<float>              m_ReferenceBoxes; // per triangle at the reference, widened by R/2
+  SurfaceCollisionDetail::BoxGrid m_ReferenceGrid;
+  std::vector<float>              m_CellClearance;
 
   // Per step.
   std::vector<float>              m_VertexDelta;   // per point: y - r, as a box rounded outward
   std::vector<float>              m_TriangleDelta; // per triangle: box of its points' y - r
   std::vector<uint8_t>            m_Active;
+  float                           m_GlobalDelta[6]{};
   SizeValueType                   m_NumberOfTestedTriangles{ 0 };
   std::vector<float>              m_SweptBoxes;
   SurfaceCollisionDetail::BoxGrid m_SweptGrid;
