@@ -691,8 +691,10 @@ StoreBox(const double * lower, const double * upper, double margin, float * box)
  * r (the proposed positions y of that step):
  * - the candidate pairs: the pairs sharing no vertex closer than a radius
  *   R = d + 0.75 mean edge lengths (found with a uniform grid of the
- *   triangles' boxes widened by R/2), each with its exact distance at r
- *   (rounded down); every other pair is at least R apart at r. Each
+ *   triangles' boxes widened by R/2), each with a lower bound of its
+ *   distance at r (the larger of the bounding spheres' gap and the gap of
+ *   the projections on the line of the centroids; the exact distance once a
+ *   step needs it); every other pair is at least R apart at r. Each
  *   triangle's clearance is the smallest distance of its candidates, at most
  *   R, less d;
  * - a pyramid of cells: level 0 has cells of side s = R + 2 r99 (r99 the
@@ -966,9 +968,27 @@ public:
             {
               continue;
             }
-            if (LargestDistance(bt, m_TriangleDelta.data() + 6 * u) < static_cast<double>(m_CandidateGaps[c]) - d)
+            const double motion = LargestDistance(bt, m_TriangleDelta.data() + 6 * u);
+            if (motion < static_cast<double>(m_CandidateGaps[c]) - d)
             {
               continue;
+            }
+            if (!m_CandidateExact[c])
+            {
+              // The pair's exact distance at the reference, once per rebuild
+              // (each direction of a pair is an entry of its own triangle's
+              // list: no two threads write one entry).
+              const IndexType * vt = m_Triangles.data() + 3 * t;
+              const IndexType * vu = m_Triangles.data() + 3 * u;
+              const double *    r = m_Reference.data();
+              const double *    a[3] = { r + 3 * vt[0], r + 3 * vt[1], r + 3 * vt[2] };
+              const double *    b[3] = { r + 3 * vu[0], r + 3 * vu[1], r + 3 * vu[2] };
+              m_CandidateGaps[c] = RoundDown(SurfaceCollisionDetail::TriangleDistance(a, b));
+              m_CandidateExact[c] = 1;
+              if (motion < static_cast<double>(m_CandidateGaps[c]) - d)
+              {
+                continue;
+              }
             }
             if (this->Violates(t, u, x, y, d))
             {
@@ -1448,20 +1468,31 @@ private:
           {
             return;
           }
+          // A lower bound of the distance: the larger of the bounding
+          // spheres' gap and the gap between the triangles' projections on
+          // the line of their centroids; the exact distance is computed
+          // when a step needs it (Constrain()).
           const double * su = m_Spheres.data() + 4 * u;
           double         e[3];
-          SurfaceCollisionDetail::Subtract(st, su, e);
-          if (std::sqrt(SurfaceCollisionDetail::Dot(e, e)) - st[3] - su[3] >= radius)
+          SurfaceCollisionDetail::Subtract(su, st, e);
+          const double centres = std::sqrt(SurfaceCollisionDetail::Dot(e, e));
+          double       gap = centres - st[3] - su[3];
+          if (centres > 0.0)
+          {
+            double top = -std::numeric_limits<double>::infinity();
+            double bottom = std::numeric_limits<double>::infinity();
+            for (unsigned int k = 0; k < 3; ++k)
+            {
+              top = std::max(top, SurfaceCollisionDetail::Dot(x + 3 * vt[k], e));
+              bottom = std::min(bottom, SurfaceCollisionDetail::Dot(x + 3 * vu[k], e));
+            }
+            gap = std::max(gap, (bottom - top) / centres * (1.0 - 1e-12) - 1e-12 * centres);
+          }
+          if (gap >= radius)
           {
             return;
           }
-          const double * a[3] = { x + 3 * vt[0], x + 3 * vt[1], x + 3 * vt[2] };
-          const double * b[3] = { x + 3 * vu[0], x + 3 * vu[1], x + 3 * vu[2] };
-          const double   gap = SurfaceCollisionDetail::TriangleDistance(a, b);
-          if (gap < radius)
-          {
-            out.push_back({ static_cast<IndexType>(t), static_cast<IndexType>(u), RoundDown(gap) });
-          }
+          out.push_back({ static_cast<IndexType>(t), static_cast<IndexType>(u), RoundDown(std::max(gap, 0.0)) });
         });
       }
     });
@@ -1480,6 +1511,7 @@ private:
     }
     m_Candidates.resize(m_CandidateOffsets[numberOfTriangles]);
     m_CandidateGaps.resize(m_Candidates.size());
+    m_CandidateExact.assign(m_Candidates.size(), 0);
     {
       std::vector<SizeValueType> fill(m_CandidateOffsets.begin(), m_CandidateOffsets.end() - 1);
       for (const auto & block : pairs)
@@ -1906,9 +1938,10 @@ private:
   std::vector<double>             m_Reference;
   std::vector<double>             m_Spheres; // per triangle at the reference: centre, radius
   std::vector<IndexType>          m_CandidateOffsets;
-  std::vector<IndexType>          m_Candidates;    // both directions
-  std::vector<float>              m_CandidateGaps; // distance at the reference, rounded down
-  std::vector<float>              m_Clearance;     // per triangle
+  std::vector<IndexType>          m_Candidates;     // both directions
+  std::vector<float>              m_CandidateGaps;  // lower bound of the distance at the reference, rounded down
+  std::vector<uint8_t>            m_CandidateExact; // the gap is the exact distance
+  std::vector<float>              m_Clearance;      // per triangle
   std::vector<CellLevel>          m_Levels;
   std::vector<IndexType>          m_CellOrder;   // triangles sorted by level-0 cell
   std::vector<IndexType>          m_CellOffsets; // level-0 cell -> range of m_CellOrder
