@@ -34,9 +34,9 @@ namespace itk
 {
 
 /** \class DeformableMeshFilter
- * \brief Explicit deformable surface: the points of a mesh move, iteration after
- * iteration, under an external force field sampled from an image and internal
- * forces that keep the surface regular.
+ * \brief Explicit deformable surface (3-D) or contour (2-D): the points of a
+ * mesh move, iteration after iteration, under an external force field sampled
+ * from an image and internal forces that keep the surface regular.
  *
  * At each iteration every vertex \f$ x_i \f$ moves by
  * \f[
@@ -140,6 +140,48 @@ namespace itk
  * depend on the input's numbering; the output keeps the input's numbering
  * and the diagnostics are indexed by the input's point identifiers. A
  * remeshed mesh keeps a local numbering (DeformableMeshRemesher).
+ *
+ * 2-D contours (snakes): with an itk::Mesh of 2-D points and a 2-D force
+ * image (vectors of 2 components, e.g. ExternalForceImageFilter on a 2-D
+ * image), the filter deforms contours by the same step: the points are held
+ * as (x, y, 0), the force image is sampled bilinearly in physical space
+ * (origin, spacing and direction honoured), and the umbrella vector of a
+ * point is the mean of its two neighbours minus the point. A contour is made
+ * of LineCell cells (one segment each, chained into open or closed contours)
+ * or of PolygonCell cells (one closed contour each, its points in order; ITK
+ * 5.2 has no polyline cell); a mesh may hold several. The normal of a point
+ * is the perpendicular of its tangent: for the segments p -> x -> q,
+ * (q - p) x z, normalised, on the right of the direction of travel.
+ * Orientation convention: each closed contour is oriented at reset so that
+ * it runs counter-clockwise (positive signed area, with x to the right and y
+ * up), whatever the order of its points in the input, so its normals point
+ * away from the region it encloses: the balloon inflates every closed
+ * contour, and the region force takes its inside as the object. An open
+ * contour keeps the direction of its points (chained from the end whose
+ * segment leaves it); its normals are on the right of that direction, and
+ * since an open contour encloses nothing, Balloon and RegionWeight raise an
+ * ExceptionObject with an open contour in the mesh. Where contours branch (a
+ * point of more than two segments) the segments keep the input's direction
+ * and the normal is the sum of theirs. Everything else is as in 3-D:
+ * elasticity (tangential or not), rigidity, ReferenceEdgeLength (on a
+ * contour the umbrella vector is about (h^2/2) times the curvature vector,
+ * so the weights mean the same at any resolution, but with h^2/2 and
+ * h^4/4 in place of the surface's h^2/4 and h^4/16), balloon, region force
+ * and edge search (IntensityImageType is then a 2-D image, smoothed in 2-D),
+ * MaximumStepLength, convergence, diagnostics, FixedBoundary and the
+ * iteration contract. PreventSelfIntersections and RemeshingEdgeLength work
+ * on the triangles of 3-D surfaces: turned on with a 2-D mesh, the update
+ * raises an ExceptionObject naming the parameter. So do a triangle or
+ * quadrilateral cell in a 2-D mesh, a contour of fewer than 2 distinct
+ * points (a vertex cell, a line from a point to itself) and a polygon cell
+ * of fewer than 3. A force image whose dimension is not the mesh's does not
+ * compile.
+ *
+ * Open meshes: the ends of an open contour and the boundary of an open
+ * surface (edges of one triangle) move like the other vertices by default,
+ * their umbrella vectors taken over their one-sided neighbourhoods (so the
+ * elastic force pulls them inward and a free open surface shrinks along its
+ * rim), or keep their input position exactly with FixedBoundary on.
  *
  * \sa ExternalForceImageFilter, IterativeMeshFilter
  * \ingroup ExplicitDeformableModel
@@ -541,14 +583,17 @@ public:
    * the elastic force pulls an end toward its neighbour, so a free open
    * contour or surface shrinks along its boundary unless the image holds it.
    * Closed contours and closed surfaces have no boundary: the parameter
-   * changes nothing for them. Not with remeshing (RemeshingEdgeLength > 0):
-   * an update with both raises an ExceptionObject. Default: off. */
+   * changes nothing for them. With remeshing (RemeshingEdgeLength > 0) the
+   * boundary vertices of the input stay fixed (the remesher never moves a
+   * boundary vertex) and the vertices it inserts at the midpoints of
+   * boundary edges are fixed where they are inserted: the boundary curve is
+   * kept exactly. Default: off. */
   itkSetMacro(FixedBoundary, bool);
   itkGetConstMacro(FixedBoundary, bool);
   itkBooleanMacro(FixedBoundary);
 
   /** Vertices on the boundary of the mesh (see FixedBoundary), found at the
-   * last reset. */
+   * last reset or remeshing. */
   SizeValueType
   GetNumberOfBoundaryVertices() const
   {

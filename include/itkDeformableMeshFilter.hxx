@@ -106,12 +106,6 @@ DeformableMeshFilter<TMesh, TForceImage>::VerifyPreconditions() const
                                                 << ", but the mesh is 2-D (contours): remeshing works on the "
                                                    "triangles of 3-D surfaces. Set RemeshingEdgeLength to 0.");
   }
-  if (m_FixedBoundary && m_RemeshingEdgeLength > 0.0)
-  {
-    itkExceptionMacro("FixedBoundary is on and RemeshingEdgeLength is "
-                      << m_RemeshingEdgeLength
-                      << ": a fixed boundary is not kept through remeshing. Turn one of them off.");
-  }
   this->VerifyImageTermParameters();
 }
 
@@ -1466,6 +1460,10 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
     this->BuildTopology(m_Triangles, edges, unique);
   }
   ++m_NumberOfRemeshings;
+  // The remesher never moves a boundary vertex and splits boundary edges at
+  // their midpoints: the new boundary vertices lie on the boundary curve and
+  // are held from now on.
+  this->FindBoundaryVertices(m_Triangles);
   // The collision test's tables for the new mesh (no check: see
   // ResetCollision()).
   this->ResetCollision(&m_Triangles, false);

@@ -359,11 +359,14 @@ DeformableMeshFilter<TMesh, TForceImage>::AddEdgeSearchSpeeds()
   }
   // An edge must drop by at least the object's robust standard deviation
   // (the transition width for a given range): noise inside the object does
-  // not make one.
-  const double contrast = (m_EstimateObjectIntensityRange || m_ObjectIntensityStatisticsGiven)
-                            ? m_ObjectIntensitySpread * m_IntensityScale
-                            : m_RegionForce.GetWidth();
-  EdgeSearch   search;
+  // not make one. And by at least 1 % of the image's intensity range: the
+  // object of a noise-free image has no spread, and the ripples of the
+  // smoothing (a millionth of the range) inside it are no edges.
+  const double contrast = std::max((m_EstimateObjectIntensityRange || m_ObjectIntensityStatisticsGiven)
+                                     ? m_ObjectIntensitySpread * m_IntensityScale
+                                     : m_RegionForce.GetWidth(),
+                                   0.01 * (m_IntensityQuantiles[1] - m_IntensityQuantiles[0]));
+  EdgeSearch search;
   search.Configure(m_EdgeSearchDistance, 0.5 * m_BackgroundStep, m_BackgroundStep, polarity, contrast);
 
   constexpr SizeValueType blockSize = 4096;
