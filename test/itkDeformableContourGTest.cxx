@@ -670,6 +670,42 @@ TEST(DeformableContour, OpenContourWithFixedOrFreeEnds)
   }
 }
 
+// The step bound and convergence on contours: a balloon of 1 mm bounded by
+// MaximumStepLength 0.25 moves a circle's points by 0.25 exactly; the
+// ellipse case with ConvergenceTolerance 0.002 pixel stops before its 1000
+// iterations with the accuracy of CircleReachesAnEllipse.
+TEST(DeformableContour, StepBoundAndConvergence)
+{
+  const PointType center = Point(20.0, 20.0);
+  auto            bounded = FilterType::New();
+  bounded->SetInput(MakeCircle(center, 10.0, 64));
+  bounded->SetForceImage(ZeroForces(40));
+  bounded->SetBalloon(1.0);
+  bounded->SetMaximumStepLength(0.25);
+  bounded->SetNumberOfIterations(1);
+  bounded->Update();
+  for (itk::IdentifierType i = 0; i < 64; ++i)
+  {
+    EXPECT_NEAR(bounded->GetOutput()->GetPoint(i).EuclideanDistanceTo(center), 10.25, 1e-12) << "point " << i;
+  }
+  EXPECT_NEAR(bounded->GetLastMaximumDisplacement(), 0.25, 1e-12);
+
+  const EllipseCase c;
+  auto              filter = c.MakeFilter(MakeCircle(c.center, 17.0, 200), 1000);
+  filter->SetRigidity(0.0);
+  filter->SetConvergenceTolerance(0.002);
+  filter->Update();
+  EXPECT_TRUE(filter->GetConverged());
+  EXPECT_LT(filter->GetCurrentIteration(), 1000u);
+  double mean = 0.0;
+  double maximum = 0.0;
+  MeasureDistance(filter->GetOutput(), Ellipse(c.center, 20.0, 14.0, 0.0), mean, maximum);
+  std::cout << "converged after " << filter->GetCurrentIteration() << " iterations: mean " << mean << " pixel, max "
+            << maximum << " pixel" << std::endl;
+  EXPECT_LE(mean, 0.1);
+  EXPECT_LE(maximum, 0.3);
+}
+
 // The iteration contract on a 2-D mesh: ten updates of one more iteration
 // with IterateFromZero off give, bit for bit, the points of one update of
 // ten iterations (which fires ten IterationEvents); IterateFromZero on
