@@ -41,6 +41,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -704,6 +705,61 @@ TEST(DeformableContour, StepBoundAndConvergence)
             << maximum << " pixel" << std::endl;
   EXPECT_LE(mean, 0.1);
   EXPECT_LE(maximum, 0.3);
+}
+
+// A contour whose points are numbered far apart (a circle of 8192 points
+// given in a shuffled order, its line cells following the circle) is
+// renumbered internally for locality: the output, in the input's numbering,
+// is the same as from the ordered circle (the balloon inflates it, the
+// normals oriented from its relabelled segments).
+TEST(DeformableContour, ShuffledNumberingGivesTheSameContour)
+{
+  constexpr unsigned int n = 8192;
+  const PointType        center = Point(50.0, 50.0);
+  const auto             ordered = MakeCircle(center, 30.0, n, false);
+  std::vector<unsigned>  position(n); // position[k]: the point id of the circle's k-th point
+  for (unsigned int k = 0; k < n; ++k)
+  {
+    position[k] = (k * 2731u) % n; // 2731 is prime to 8192: a permutation
+  }
+  auto shuffled = MeshType::New();
+  for (unsigned int k = 0; k < n; ++k)
+  {
+    shuffled->SetPoint(position[k], ordered->GetPoint(k));
+  }
+  for (unsigned int k = 0; k < n; ++k)
+  {
+    CellType::CellAutoPointer cell;
+    cell.TakeOwnership(new LineType);
+    cell->SetPointId(0, position[k]);
+    cell->SetPointId(1, position[(k + 1) % n]);
+    shuffled->SetCell(k, cell);
+  }
+  std::vector<FilterType::Pointer> filters;
+  for (const MeshType * input : { ordered.GetPointer(), shuffled.GetPointer() })
+  {
+    auto filter = FilterType::New();
+    filter->SetInput(input);
+    filter->SetForceImage(ZeroForces(100));
+    filter->SetBalloon(0.1);
+    filter->SetElasticity(0.3);
+    filter->SetNumberOfIterations(3);
+    filter->Update();
+    filters.push_back(filter);
+  }
+  // The shuffled input was renumbered, the ordered one not.
+  std::ostringstream printed[2];
+  filters[0]->Print(printed[0]);
+  filters[1]->Print(printed[1]);
+  EXPECT_NE(printed[0].str().find("Renumbered: false"), std::string::npos);
+  EXPECT_NE(printed[1].str().find("Renumbered: true"), std::string::npos);
+  for (unsigned int k = 0; k < n; ++k)
+  {
+    const auto a = filters[0]->GetOutput()->GetPoint(k);
+    const auto b = filters[1]->GetOutput()->GetPoint(position[k]);
+    ASSERT_NEAR(a.EuclideanDistanceTo(b), 0.0, 1e-9) << "point " << k;
+    ASSERT_NEAR(a.EuclideanDistanceTo(center), 30.3, 1e-3) << "point " << k;
+  }
 }
 
 // The iteration contract on a 2-D mesh: ten updates of one more iteration
