@@ -43,7 +43,7 @@ namespace itk
  *   \Delta x_i = s\,F(x_i) + a\,E_i + b\,R_i + \beta\,n_i
  * \f]
  * where
- * - \f$ F \f$ is the force image sampled by trilinear interpolation at the
+ * - \f$ F \f$ is the force image sampled by trilinear (2-D: bilinear) interpolation at the
  *   physical position of the vertex (origin, spacing and direction of the
  *   image honoured; a vertex outside the image gets no external force),
  *   \f$ s \f$ the ScaleFactor;
@@ -56,7 +56,8 @@ namespace itk
  *   (Cohen's inflation force).
  *
  * The neighbours come from the mesh's cells (edges of triangles, polygons, lines
- * and polylines); normals from its triangles and polygons. The explicit update
+ * and polylines); normals from its triangles and polygons (2-D: from the
+ * contours' segments, see below). The explicit update
  * of the internal terms is stable when \f$ a + 2b \le 1 \f$; larger sums are
  * scaled down to 1 so that every valid parameter set gives a stable iteration.
  * MaximumStepLength, when positive, bounds the length of each vertex's
