@@ -34,16 +34,16 @@ namespace itk
 {
 
 /** \class DeformableMeshFilter
- * \brief Explicit deformable surface: the points of a mesh move, iteration after
- * iteration, under an external force field sampled from an image and internal
- * forces that keep the surface regular.
+ * \brief Explicit deformable surface (3-D) or contour (2-D): the points of a
+ * mesh move, iteration after iteration, under an external force field sampled
+ * from an image and internal forces that keep the surface regular.
  *
  * At each iteration every vertex \f$ x_i \f$ moves by
  * \f[
  *   \Delta x_i = s\,F(x_i) + a\,E_i + b\,R_i + \beta\,n_i
  * \f]
  * where
- * - \f$ F \f$ is the force image sampled by trilinear interpolation at the
+ * - \f$ F \f$ is the force image sampled by trilinear (2-D: bilinear) interpolation at the
  *   physical position of the vertex (origin, spacing and direction of the
  *   image honoured; a vertex outside the image gets no external force),
  *   \f$ s \f$ the ScaleFactor;
@@ -56,7 +56,8 @@ namespace itk
  *   (Cohen's inflation force).
  *
  * The neighbours come from the mesh's cells (edges of triangles, polygons, lines
- * and polylines); normals from its triangles and polygons. The explicit update
+ * and polylines); normals from its triangles and polygons (2-D: from the
+ * contours' segments, see below). The explicit update
  * of the internal terms is stable when \f$ a + 2b \le 1 \f$; larger sums are
  * scaled down to 1 so that every valid parameter set gives a stable iteration.
  * MaximumStepLength, when positive, bounds the length of each vertex's
@@ -141,6 +142,48 @@ namespace itk
  * and the diagnostics are indexed by the input's point identifiers. A
  * remeshed mesh keeps a local numbering (DeformableMeshRemesher).
  *
+ * 2-D contours (snakes): with an itk::Mesh of 2-D points and a 2-D force
+ * image (vectors of 2 components, e.g. ExternalForceImageFilter on a 2-D
+ * image), the filter deforms contours by the same step: the points are held
+ * as (x, y, 0), the force image is sampled bilinearly in physical space
+ * (origin, spacing and direction honoured), and the umbrella vector of a
+ * point is the mean of its two neighbours minus the point. A contour is made
+ * of LineCell cells (one segment each, chained into open or closed contours)
+ * or of PolygonCell cells (one closed contour each, its points in order; ITK
+ * 5.2 has no polyline cell); a mesh may hold several. The normal of a point
+ * is the perpendicular of its tangent: for the segments p -> x -> q,
+ * (q - p) x z, normalised, on the right of the direction of travel.
+ * Orientation convention: each closed contour is oriented at reset so that
+ * it runs counter-clockwise (positive signed area, with x to the right and y
+ * up), whatever the order of its points in the input, so its normals point
+ * away from the region it encloses: the balloon inflates every closed
+ * contour, and the region force takes its inside as the object. An open
+ * contour keeps the direction of its points (chained from the end whose
+ * segment leaves it); its normals are on the right of that direction, and
+ * since an open contour encloses nothing, Balloon and RegionWeight raise an
+ * ExceptionObject with an open contour in the mesh. Where contours branch (a
+ * point of more than two segments) the segments keep the input's direction
+ * and the normal is the sum of theirs. Everything else is as in 3-D:
+ * elasticity (tangential or not), rigidity, ReferenceEdgeLength (on a
+ * contour the umbrella vector is about (h^2/2) times the curvature vector,
+ * so the weights mean the same at any resolution, but with h^2/2 and
+ * h^4/4 in place of the surface's h^2/4 and h^4/16), balloon, region force
+ * and edge search (IntensityImageType is then a 2-D image, smoothed in 2-D),
+ * MaximumStepLength, convergence, diagnostics, FixedBoundary and the
+ * iteration contract. PreventSelfIntersections and RemeshingEdgeLength work
+ * on the triangles of 3-D surfaces: turned on with a 2-D mesh, the update
+ * raises an ExceptionObject naming the parameter. So do a triangle or
+ * quadrilateral cell in a 2-D mesh, a contour of fewer than 2 distinct
+ * points (a vertex cell, a line from a point to itself) and a polygon cell
+ * of fewer than 3. A force image whose dimension is not the mesh's does not
+ * compile.
+ *
+ * Open meshes: the ends of an open contour and the boundary of an open
+ * surface (edges of one triangle) move like the other vertices by default,
+ * their umbrella vectors taken over their one-sided neighbourhoods (so the
+ * elastic force pulls them inward and a free open surface shrinks along its
+ * rim), or keep their input position exactly with FixedBoundary on.
+ *
  * \sa ExternalForceImageFilter, IterativeMeshFilter
  * \ingroup ExplicitDeformableModel
  */
@@ -167,14 +210,17 @@ public:
   using ForcePixelType = typename ForceImageType::PixelType;
 
   static constexpr unsigned int PointDimension = Superclass::PointDimension;
-  static_assert(PointDimension == 3, "DeformableMeshFilter deforms 3-D meshes.");
-  static_assert(ForceImageType::ImageDimension == 3, "The force image must be 3-D.");
-  static_assert(ForcePixelType::Dimension == 3, "The force image pixels must have 3 components.");
+  static_assert(PointDimension == 2 || PointDimension == 3,
+                "DeformableMeshFilter deforms 3-D surfaces and 2-D contours.");
+  static_assert(ForceImageType::ImageDimension == PointDimension,
+                "The force image must have the dimension of the mesh's points.");
+  static_assert(ForcePixelType::Dimension == PointDimension,
+                "The force image pixels must have as many components as the mesh's points.");
 
-  /** The external force field: a 3-D image of 3-component vectors
-   * (itk::Vector or itk::CovariantVector, float or double) expressed in
-   * physical space, for example the output of ExternalForceImageFilter.
-   * Required. */
+  /** The external force field: an image of vectors of the mesh's dimension
+   * (itk::Vector or itk::CovariantVector, float or double; 3-D for a
+   * surface, 2-D for contours) expressed in physical space, for example the
+   * output of ExternalForceImageFilter. Required. */
   itkSetInputMacro(ForceImage, ForceImageType);
   itkGetInputMacro(ForceImage, ForceImageType);
 
@@ -223,10 +269,11 @@ public:
   itkSetMacro(Balloon, double);
   itkGetConstMacro(Balloon, double);
 
-  /** The intensity image of the region force: a 3-D scalar image in the same
-   * physical space as the force image (typically the image the force field
-   * was computed from). Optional; needed when RegionWeight > 0. */
-  using IntensityImageType = Image<float, 3>;
+  /** The intensity image of the region force: a scalar image of the mesh's
+   * dimension in the same physical space as the force image (typically the
+   * image the force field was computed from). Optional; needed when
+   * RegionWeight > 0. */
+  using IntensityImageType = Image<float, PointDimension>;
   itkSetInputMacro(IntensityImage, IntensityImageType);
   itkGetInputMacro(IntensityImage, IntensityImageType);
 
@@ -521,8 +568,43 @@ public:
   itkBooleanMacro(RenumberForLocality);
 
   /** Sign applied to the triangles' orientation to get outward normals: +1 for
-   * an outward-oriented mesh, -1 for an inward-oriented one. Set by Reset(). */
+   * an outward-oriented mesh, -1 for an inward-oriented one. Set by Reset().
+   * Always +1 for 2-D contours, whose orientation is normalised contour by
+   * contour (see the class documentation). */
   itkGetConstMacro(OrientationSign, double);
+
+  /** The boundary of an open mesh: the ends of an open 2-D contour, and the
+   * boundary of an open 3-D surface (the vertices of edges that belong to
+   * one triangle only, and the ends of line and polyline cells). When on,
+   * these vertices keep their input position exactly (bit for bit) at every
+   * iteration: a fixed boundary, as for a snake pinned at both ends or a
+   * patch of surface attached along its rim. When off (default, the
+   * behaviour of earlier versions), they move like the other vertices,
+   * their internal forces coming from their neighbours on one side only:
+   * the elastic force pulls an end toward its neighbour, so a free open
+   * contour or surface shrinks along its boundary unless the image holds it.
+   * Closed contours and closed surfaces have no boundary: the parameter
+   * changes nothing for them. With remeshing (RemeshingEdgeLength > 0) the
+   * boundary vertices of the input stay fixed (the remesher never moves a
+   * boundary vertex) and the vertices it inserts at the midpoints of
+   * boundary edges are fixed where they are inserted: the boundary curve is
+   * kept exactly. Default: off. */
+  itkSetMacro(FixedBoundary, bool);
+  itkGetConstMacro(FixedBoundary, bool);
+  itkBooleanMacro(FixedBoundary);
+
+  /** Vertices on the boundary of the mesh (see FixedBoundary), found at the
+   * last reset or remeshing. */
+  SizeValueType
+  GetNumberOfBoundaryVertices() const
+  {
+    return m_BoundaryVertices.size();
+  }
+
+  /** 2-D contours found at the last reset: closed ones (cycles of segments)
+   * and open ones (chains with two ends). 0 for a 3-D mesh. */
+  itkGetConstMacro(NumberOfClosedContours, SizeValueType);
+  itkGetConstMacro(NumberOfOpenContours, SizeValueType);
 
 protected:
   DeformableMeshFilter();
@@ -554,12 +636,38 @@ private:
 
   /** The triangles (polygons fan-triangulated, for the normals) and edges of
    * the input's cells; \a onlyTriangles tells whether all cells are
-   * triangles. */
+   * triangles. For a 2-D mesh, \a triangles receives instead the directed
+   * segments of the contours (2 point indices each, a line or polyline cell's
+   * points in order); surface cells are refused. */
   void
   GatherInputCells(std::vector<IndexType32> & triangles, std::vector<uint64_t> & edges, bool & onlyTriangles) const;
 
+  /** 2-D: removes duplicate segments and orients each contour: the segments
+   * of an open contour (a chain) follow one direction, that of its first
+   * segment from one end, and those of a closed contour (a cycle) run
+   * counter-clockwise (positive signed area), so that the normal (c - b) x z
+   * of each segment b -> c points outward. Where contours branch (a point
+   * with more than two neighbours) the segments keep the input's direction.
+   * Counts the contours; throws on a closed contour of fewer than 3 points. */
+  void
+  OrientContours(std::vector<IndexType32> & segments);
+
+  /** The boundary vertices (see FixedBoundary) of the cached mesh, from the
+   * triangles (2-D: the segments) in the cache's numbering. */
+  void
+  FindBoundaryVertices(const std::vector<IndexType32> & triangles);
+
+  /** Gives the boundary vertices their coordinates of \a start in
+   * m_NextCoordinates (FixedBoundary); when \a blockMaximum is given,
+   * recomputes the largest displacement of the blocks that hold one and
+   * zeroes their diagnosed displacement when \a diagnose. */
+  void
+  HoldBoundary(const double * start, std::vector<double> * blockMaximum, bool diagnose);
+
   /** The step's tables from triangles and edges (min << 32 | max, any order,
-   * duplicates allowed unless \a edgesUnique; consumed). */
+   * duplicates allowed unless \a edgesUnique; consumed). For a 2-D mesh
+   * \a triangles holds the oriented segments of the contours, 2 indices
+   * each (OrientContours()). */
   void
   BuildTopology(const std::vector<IndexType32> & triangles, std::vector<uint64_t> & edges, bool edgesUnique = false);
 
@@ -677,12 +785,19 @@ private:
   unsigned int  m_BackgroundUpdateInterval{ 10 };
   double        m_ConvergenceTolerance{ 0.0 };
   unsigned int  m_ConvergenceWindow{ 3 };
-  double        m_RemeshingEdgeLength{ 0.0 };
-  unsigned int  m_RemeshingInterval{ 10 };
-  bool          m_RenumberForLocality{ true };
-  bool          m_Renumbered{ false };
-  double        m_FarEdgeFraction{ 0.0 };
-  SizeValueType m_NumberOfRemeshings{ 0 };
+  bool          m_FixedBoundary{ false };
+  SizeValueType m_NumberOfClosedContours{ 0 };
+  SizeValueType m_NumberOfOpenContours{ 0 };
+  // The boundary vertices (cache's numbering, increasing), found at reset;
+  // for a 2-D mesh the first end of an open contour, or none (-1).
+  std::vector<IndexType32> m_BoundaryVertices;
+  int64_t                  m_FirstContourEnd{ -1 };
+  double                   m_RemeshingEdgeLength{ 0.0 };
+  unsigned int             m_RemeshingInterval{ 10 };
+  bool                     m_RenumberForLocality{ true };
+  bool                     m_Renumbered{ false };
+  double                   m_FarEdgeFraction{ 0.0 };
+  SizeValueType            m_NumberOfRemeshings{ 0 };
   // The surface's triangles in the internal numbering (remeshing only).
   std::vector<IndexType32> m_Triangles;
   DeformableMeshRemesher   m_Remesher;
@@ -733,7 +848,10 @@ private:
 
   // Image terms: the smoothed intensity image (kept while the input image and
   // RegionSigma are unchanged), its sampler and the object's model.
-  typename IntensityImageType::Pointer         m_SmoothedIntensity;
+  // (3-D; a 2-D intensity image is smoothed in 2-D, then held as the slice
+  // z = 0 of a 3-D image, which the samplers read as bilinear.)
+  using SmoothedIntensityImageType = Image<float, 3>;
+  typename SmoothedIntensityImageType::Pointer m_SmoothedIntensity;
   ModifiedTimeType                             m_SmoothedIntensityTime{ 0 };
   const IntensityImageType *                   m_SmoothedIntensitySource{ nullptr };
   double                                       m_SmoothedIntensitySigma{ -1.0 };

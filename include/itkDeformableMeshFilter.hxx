@@ -40,6 +40,8 @@ DeformableMeshFilter<TMesh, TForceImage>::DeformableMeshFilter()
   // The force image is checked in VerifyPreconditions() with a clearer message
   // than the generic one of a required input.
   this->SetNumberOfRequiredInputs(1);
+  // The step works on 3-D vectors: a 2-D point is cached as (x, y, 0).
+  this->SetCoordinateStride(3);
 }
 
 template <typename TMesh, typename TForceImage>
@@ -93,6 +95,17 @@ DeformableMeshFilter<TMesh, TForceImage>::VerifyPreconditions() const
   {
     itkExceptionMacro("MinimumDistance must be finite and non-negative; it is " << m_MinimumDistance << ".");
   }
+  if (PointDimension == 2 && m_PreventSelfIntersections)
+  {
+    itkExceptionMacro("PreventSelfIntersections is on, but the mesh is 2-D (contours): the collision test works on "
+                      "the triangles of 3-D surfaces. Turn PreventSelfIntersections off.");
+  }
+  if (PointDimension == 2 && m_RemeshingEdgeLength > 0.0)
+  {
+    itkExceptionMacro("RemeshingEdgeLength is " << m_RemeshingEdgeLength
+                                                << ", but the mesh is 2-D (contours): remeshing works on the "
+                                                   "triangles of 3-D surfaces. Set RemeshingEdgeLength to 0.");
+  }
   this->VerifyImageTermParameters();
 }
 
@@ -125,12 +138,14 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareForceSampler()
   }
   m_ForceBuffer = image->GetBufferPointer();
 
+  // A 2-D image is sampled as the slice z = 0 of a 3-D one: the points'
+  // z is 0, so the third weight is 0 and the trilinear sample is bilinear.
   DeformableMeshFilterDetail::PhysicalToIndexMatrix(image, m_PhysicalToIndex);
   for (unsigned int r = 0; r < 3; ++r)
   {
-    m_ForceOrigin[r] = image->GetOrigin()[r];
-    m_BufferStart[r] = static_cast<double>(region.GetIndex()[r]);
-    m_BufferSize[r] = static_cast<int64_t>(region.GetSize()[r]);
+    m_ForceOrigin[r] = r < PointDimension ? image->GetOrigin()[r] : 0.0;
+    m_BufferStart[r] = r < PointDimension ? static_cast<double>(region.GetIndex()[r]) : 0.0;
+    m_BufferSize[r] = r < PointDimension ? static_cast<int64_t>(region.GetSize()[r]) : 1;
   }
   // Continuous index c = M (x - origin) - start = M x - (M origin + start).
   DeformableMeshFilterDetail::ForceSampler<ForcePixelType> & sampler = m_Sampler;
@@ -204,6 +219,45 @@ DeformableMeshFilter<TMesh, TForceImage>::GatherInputCells(std::vector<IndexType
         }
       }
       onlyTriangles = onlyTriangles && type == CommonEnums::CellGeometry::TRIANGLE_CELL && n == 3;
+      if (PointDimension == 2)
+      {
+        // Contours: line cells (a segment each, chained into open or closed
+        // contours) and polygon cells (a closed contour each, its points in
+        // order); ITK 5.2 has no polyline cell.
+        const bool isPolygon = type == CommonEnums::CellGeometry::POLYGON_CELL;
+        if (!isCurve && !isPolygon && type != CommonEnums::CellGeometry::VERTEX_CELL)
+        {
+          itkExceptionMacro(
+            "Cell " << it.Index()
+                    << " is a surface or volume cell (triangle, quadrilateral...), but the mesh is 2-D: "
+                       "a 2-D mesh holds contours, as line cells and polygon cells (closed contours).");
+        }
+        unsigned int distinct = n;
+        for (unsigned int k = 0; k < n && n > 1; ++k)
+        {
+          distinct -= ids[k] == ids[(k + 1) % n] ? 1 : 0;
+        }
+        if (isPolygon ? distinct < 3 : (n < 2 || ids[0] == ids[1]))
+        {
+          itkExceptionMacro("Cell " << it.Index() << " is a " << (isPolygon ? "closed contour" : "contour") << " of "
+                                    << (isPolygon ? distinct : 1)
+                                    << " distinct point(s): an open contour needs at least 2 points, a closed one "
+                                       "(polygon cell) at least 3.");
+        }
+        const unsigned int segments = isPolygon ? n : 1;
+        for (unsigned int k = 0; k < segments; ++k)
+        {
+          const auto a = ids[k];
+          const auto b = ids[(k + 1) % n];
+          if (a != b)
+          {
+            triangles.push_back(static_cast<IndexType32>(a));
+            triangles.push_back(static_cast<IndexType32>(b));
+            addEdge(a, b);
+          }
+        }
+        continue;
+      }
       if (isSurface && n >= 3)
       {
         for (unsigned int k = 0; k < n; ++k)
@@ -269,7 +323,10 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology(const std::vector<IndexT
 
   // For each vertex, the edges opposite it in its triangles, oriented as the
   // triangles: pairs (b, c); its normal sums (b - x) x (c - x) over them.
-  const SizeValueType      numberOfTriangles = triangles.size() / 3;
+  // 2-D: the segments b -> c that hold the vertex (its normal sums
+  // (c - b) x z); no vertex has a fan, all are GeneralVertex.
+  constexpr unsigned int   cellSize = PointDimension == 2 ? 2 : 3;
+  const SizeValueType      numberOfTriangles = triangles.size() / cellSize;
   std::vector<IndexType32> pairOffsets(numberOfPoints + 1, 0);
   for (const IndexType32 v : triangles)
   {
@@ -284,11 +341,19 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology(const std::vector<IndexT
     std::vector<IndexType32> fill(pairOffsets.begin(), pairOffsets.end() - 1);
     for (SizeValueType t = 0; t < numberOfTriangles; ++t)
     {
-      for (unsigned int k = 0; k < 3; ++k)
+      for (unsigned int k = 0; k < cellSize; ++k)
       {
-        IndexType32 * pair = pairs.data() + 2 * static_cast<SizeValueType>(fill[triangles[3 * t + k]]++);
-        pair[0] = triangles[3 * t + (k + 1) % 3];
-        pair[1] = triangles[3 * t + (k + 2) % 3];
+        IndexType32 * pair = pairs.data() + 2 * static_cast<SizeValueType>(fill[triangles[cellSize * t + k]]++);
+        if (cellSize == 2)
+        {
+          pair[0] = triangles[2 * t];
+          pair[1] = triangles[2 * t + 1];
+        }
+        else
+        {
+          pair[0] = triangles[3 * t + (k + 1) % 3];
+          pair[1] = triangles[3 * t + (k + 2) % 3];
+        }
       }
     }
   }
@@ -346,7 +411,7 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology(const std::vector<IndexT
       {
         kind = ClosedRing; // isolated vertex: no umbrella, no normal
       }
-      else if (numberOfPairs > 0 && oneFanPossible)
+      else if (numberOfPairs > 0 && oneFanPossible && PointDimension == 3)
       {
         // Start at a pair whose b ends no other pair (a boundary fan), if any.
         IndexType32 start = 0;
@@ -498,7 +563,9 @@ DeformableMeshFilter<TMesh, TForceImage>::FinishTopology(const std::vector<Index
 {
   using namespace DeformableMeshFilterDetail;
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
-  const SizeValueType numberOfTriangles = triangles.size() / 3;
+  // 2-D: \a triangles holds the contours' segments, oriented contour by
+  // contour (OrientContours()): the sign is +1.
+  const SizeValueType numberOfTriangles = PointDimension == 2 ? 0 : triangles.size() / 3;
   // Outward orientation from the signed volume enclosed by the triangles.
   const double * x = this->GetCoordinates().data();
   double         volume = 0.0;
@@ -553,6 +620,266 @@ DeformableMeshFilter<TMesh, TForceImage>::FinishTopology(const std::vector<Index
 
 template <typename TMesh, typename TForceImage>
 void
+DeformableMeshFilter<TMesh, TForceImage>::OrientContours(std::vector<IndexType32> & segments)
+{
+  const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
+  const double *      x = this->GetCoordinates().data();
+  // One segment per pair of points (the first one given keeps its direction).
+  {
+    std::vector<std::pair<uint64_t, SizeValueType>> keys;
+    keys.reserve(segments.size() / 2);
+    for (SizeValueType s = 0; s < segments.size() / 2; ++s)
+    {
+      const uint64_t a = segments[2 * s];
+      const uint64_t b = segments[2 * s + 1];
+      keys.emplace_back(std::min(a, b) << 32 | std::max(a, b), s);
+    }
+    std::sort(keys.begin(), keys.end());
+    std::vector<IndexType32> unique;
+    unique.reserve(segments.size());
+    for (std::size_t k = 0; k < keys.size(); ++k)
+    {
+      if (k == 0 || keys[k].first != keys[k - 1].first)
+      {
+        unique.push_back(segments[2 * keys[k].second]);
+        unique.push_back(segments[2 * keys[k].second + 1]);
+      }
+    }
+    segments.swap(unique);
+  }
+  const SizeValueType numberOfSegments = segments.size() / 2;
+  // The segments of each point (CSR).
+  std::vector<IndexType32> offsets(numberOfPoints + 1, 0);
+  for (const IndexType32 v : segments)
+  {
+    ++offsets[v + 1];
+  }
+  for (SizeValueType i = 0; i < numberOfPoints; ++i)
+  {
+    offsets[i + 1] += offsets[i];
+  }
+  std::vector<IndexType32> incident(offsets[numberOfPoints]);
+  {
+    std::vector<IndexType32> fill(offsets.begin(), offsets.end() - 1);
+    for (SizeValueType s = 0; s < numberOfSegments; ++s)
+    {
+      incident[fill[segments[2 * s]]++] = static_cast<IndexType32>(s);
+      incident[fill[segments[2 * s + 1]]++] = static_cast<IndexType32>(s);
+    }
+  }
+  const auto               degree = [&](SizeValueType i) { return offsets[i + 1] - offsets[i]; };
+  std::vector<uint8_t>     visited(numberOfSegments, 0);
+  std::vector<IndexType32> walk;
+  // Walks from point \a start along segment \a first while the points have
+  // two segments; orients the segments along the walk. Returns whether it
+  // came back to \a start (a closed contour).
+  const auto follow = [&](IndexType32 start, IndexType32 first) {
+    walk.clear();
+    IndexType32 point = start;
+    IndexType32 segment = first;
+    while (true)
+    {
+      visited[segment] = 1;
+      walk.push_back(segment);
+      IndexType32 * ends = segments.data() + 2 * static_cast<SizeValueType>(segment);
+      if (ends[0] != point)
+      {
+        std::swap(ends[0], ends[1]);
+      }
+      point = ends[1];
+      if (point == start || degree(point) != 2)
+      {
+        return point == start;
+      }
+      const IndexType32 * mine = incident.data() + offsets[point];
+      segment = mine[0] == segment ? mine[1] : mine[0];
+      if (visited[segment])
+      {
+        return false;
+      }
+    }
+  };
+  const auto reverseWalk = [&]() {
+    for (const IndexType32 segment : walk)
+    {
+      std::swap(segments[2 * static_cast<SizeValueType>(segment)],
+                segments[2 * static_cast<SizeValueType>(segment) + 1]);
+    }
+  };
+  m_NumberOfOpenContours = 0;
+  m_NumberOfClosedContours = 0;
+  m_FirstContourEnd = -1;
+  // Open contours from their ends, in the direction of the end's segment as
+  // given (so that a chain given in one direction keeps it).
+  for (SizeValueType i = 0; i < numberOfPoints; ++i)
+  {
+    if (degree(i) != 1 || visited[incident[offsets[i]]])
+    {
+      continue;
+    }
+    const IndexType32 first = incident[offsets[i]];
+    const bool        leaving = segments[2 * static_cast<SizeValueType>(first)] == i;
+    follow(static_cast<IndexType32>(i), first);
+    if (!leaving)
+    {
+      reverseWalk();
+    }
+    ++m_NumberOfOpenContours;
+    if (m_FirstContourEnd < 0)
+    {
+      m_FirstContourEnd = static_cast<int64_t>(i);
+    }
+  }
+  // Closed contours: counter-clockwise (positive signed area).
+  for (SizeValueType i = 0; i < numberOfPoints; ++i)
+  {
+    if (degree(i) != 2 || visited[incident[offsets[i]]])
+    {
+      continue;
+    }
+    const IndexType32 first = incident[offsets[i]];
+    if (!follow(static_cast<IndexType32>(i), first))
+    {
+      continue; // a chain between branch points: as given
+    }
+    double area = 0.0;
+    for (const IndexType32 segment : walk)
+    {
+      const double * a = x + 3 * static_cast<SizeValueType>(segments[2 * static_cast<SizeValueType>(segment)]);
+      const double * b = x + 3 * static_cast<SizeValueType>(segments[2 * static_cast<SizeValueType>(segment) + 1]);
+      area += a[0] * b[1] - a[1] * b[0];
+    }
+    if (walk.size() < 3)
+    {
+      itkExceptionMacro("A closed contour through point #" << i << " has " << walk.size()
+                                                           << " point(s): a closed contour needs at least 3.");
+    }
+    if (area < 0.0)
+    {
+      reverseWalk();
+    }
+    ++m_NumberOfClosedContours;
+  }
+}
+
+template <typename TMesh, typename TForceImage>
+void
+DeformableMeshFilter<TMesh, TForceImage>::FindBoundaryVertices(const std::vector<IndexType32> & triangles)
+{
+  using namespace DeformableMeshFilterDetail;
+  const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
+  m_BoundaryVertices.clear();
+  const auto neighbourCount = [this](SizeValueType i) { return m_NeighbourOffsets[i + 1] - m_NeighbourOffsets[i]; };
+  if (PointDimension == 2)
+  {
+    // The ends of open contours.
+    for (SizeValueType i = 0; i < numberOfPoints; ++i)
+    {
+      if (neighbourCount(i) == 1)
+      {
+        m_BoundaryVertices.push_back(static_cast<IndexType32>(i));
+      }
+    }
+    return;
+  }
+  // A closed manifold surface (every vertex in one closed fan, or isolated)
+  // has no boundary: nothing to sort.
+  bool anyOpen = false;
+  for (SizeValueType i = 0; i < numberOfPoints && !anyOpen; ++i)
+  {
+    anyOpen = m_RingKinds[i] != ClosedRing;
+  }
+  if (!anyOpen)
+  {
+    return;
+  }
+  // The edges of one triangle only, and the ends of lines (one neighbour,
+  // in no triangle).
+  std::vector<uint8_t>  boundary(numberOfPoints, 0);
+  std::vector<uint8_t>  inTriangle(numberOfPoints, 0);
+  std::vector<uint64_t> edges;
+  edges.reserve(triangles.size());
+  for (SizeValueType t = 0; t < triangles.size() / 3; ++t)
+  {
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      const uint64_t a = triangles[3 * t + k];
+      const uint64_t b = triangles[3 * t + (k + 1) % 3];
+      edges.push_back(std::min(a, b) << 32 | std::max(a, b));
+      inTriangle[a] = 1;
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t k = 0; k < edges.size();)
+  {
+    std::size_t end = k + 1;
+    while (end < edges.size() && edges[end] == edges[k])
+    {
+      ++end;
+    }
+    if (end - k == 1)
+    {
+      boundary[edges[k] >> 32] = 1;
+      boundary[edges[k] & 0xffffffffULL] = 1;
+    }
+    k = end;
+  }
+  for (SizeValueType i = 0; i < numberOfPoints; ++i)
+  {
+    if (boundary[i] || (!inTriangle[i] && neighbourCount(i) == 1))
+    {
+      m_BoundaryVertices.push_back(static_cast<IndexType32>(i));
+    }
+  }
+}
+
+template <typename TMesh, typename TForceImage>
+void
+DeformableMeshFilter<TMesh, TForceImage>::HoldBoundary(const double *        start,
+                                                       std::vector<double> * blockMaximum,
+                                                       bool                  diagnose)
+{
+  using DeformableMeshFilterDetail::BlockSize;
+  double * next = m_NextCoordinates.data();
+  for (const IndexType32 i : m_BoundaryVertices)
+  {
+    std::copy(start + 3 * static_cast<SizeValueType>(i),
+              start + 3 * static_cast<SizeValueType>(i) + 3,
+              next + 3 * static_cast<SizeValueType>(i));
+    if (diagnose)
+    {
+      m_DisplacementMagnitudes[i] = 0.0f;
+    }
+  }
+  if (blockMaximum == nullptr)
+  {
+    return;
+  }
+  // The largest displacement of the blocks that hold a boundary vertex.
+  const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
+  SizeValueType       lastBlock = std::numeric_limits<SizeValueType>::max();
+  for (const IndexType32 i : m_BoundaryVertices)
+  {
+    const SizeValueType block = i / BlockSize;
+    if (block == lastBlock)
+    {
+      continue;
+    }
+    lastBlock = block;
+    double largest = 0.0;
+    for (SizeValueType j = block * BlockSize; j < std::min(numberOfPoints, (block + 1) * BlockSize); ++j)
+    {
+      const double dx = next[3 * j] - start[3 * j];
+      const double dy = next[3 * j + 1] - start[3 * j + 1];
+      const double dz = next[3 * j + 2] - start[3 * j + 2];
+      largest = std::max(largest, dx * dx + dy * dy + dz * dz);
+    }
+    (*blockMaximum)[block] = std::sqrt(largest);
+  }
+}
+
+template <typename TMesh, typename TForceImage>
+void
 DeformableMeshFilter<TMesh, TForceImage>::Reset()
 {
   std::vector<IndexType32> triangles;
@@ -566,17 +893,28 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
                                                    "polygons, vertices): remeshing works on triangle meshes only. "
                                                    "Triangulate the mesh or set RemeshingEdgeLength to 0.");
   }
+  if (PointDimension == 2)
+  {
+    this->OrientContours(triangles);
+  }
+  else
+  {
+    m_NumberOfOpenContours = 0;
+    m_NumberOfClosedContours = 0;
+    m_FirstContourEnd = -1;
+  }
   this->RenumberForLocality(triangles, edges);
   this->BuildTopology(triangles, edges);
+  this->FindBoundaryVertices(triangles);
   // The collision test takes the triangles in the cache's numbering when
   // the points were renumbered (the input's cells otherwise, which also
   // name the cells of an intersecting pair).
   std::vector<IndexType32> renumberedTriangles;
-  if (m_Renumbered)
+  if (m_Renumbered && PointDimension == 3)
   {
     renumberedTriangles = triangles;
   }
-  if (m_RemeshingEdgeLength > 0.0)
+  if (m_RemeshingEdgeLength > 0.0 && PointDimension == 3)
   {
     m_Triangles.swap(triangles);
   }
@@ -738,6 +1076,17 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   const bool scaled = m_ReferenceEdgeLength > 0.0 && (useElasticity || m_Rigidity > 0.0);
   const bool useRigidity = m_Rigidity > 0.0 || useImageTerms || scaled;
   const bool useNormal = m_Balloon != 0.0 || (useElasticity && m_TangentialElasticity) || useImageTerms;
+  if (m_FirstContourEnd >= 0 && (m_Balloon != 0.0 || m_RegionWeight > 0.0))
+  {
+    // Outward is the side away from the region a closed contour encloses;
+    // an open contour encloses none.
+    const std::string parameter = m_Balloon != 0.0 ? "Balloon" : "RegionWeight";
+    const double      value = m_Balloon != 0.0 ? m_Balloon : m_RegionWeight;
+    itkExceptionMacro(<< parameter << " is " << value << ", but the mesh has " << m_NumberOfOpenContours
+                      << " open contour(s) (point #" << m_FirstContourEnd
+                      << " is an end): outward is undefined for an open contour. Close the contour(s) or set "
+                      << parameter << " to 0.");
+  }
 
   if (m_DisplacementMagnitudes.size() != numberOfPoints)
   {
@@ -783,7 +1132,8 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   const MeshTables    mesh{ m_NeighbourOffsets.data(), m_Neighbours.data(),
                          m_RingKinds.data(),        m_GeneralVertices.data(),
                          m_GeneralVertices.size(),  m_GeneralPairOffsets.data(),
-                         m_GeneralPairs.data(),     ordered ? m_ValenceOrder.data() : nullptr };
+                         m_GeneralPairs.data(),     ordered ? m_ValenceOrder.data() : nullptr,
+                         PointDimension == 2 };
   StepArrays          arrays{ coordinates.data(),
                      m_NextCoordinates.data(),
                      m_Umbrella.data(),
@@ -888,6 +1238,10 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
     for (unsigned int k = 1; k < m_NumberOfSubSteps; ++k)
     {
       stepPass(internalTerms, false);
+      if (m_FixedBoundary)
+      {
+        this->HoldBoundary(coordinates.data(), nullptr, false);
+      }
       coordinates.swap(m_NextCoordinates);
       arrays.coordinates = coordinates.data();
       arrays.next = m_NextCoordinates.data();
@@ -911,6 +1265,10 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   const StepTerms terms{ rule.scaleFactor, rule.elasticity,        rule.rigidity,    rule.tangential,
                          rule.balloon,     rule.maximumStepLength, m_OrientationSign };
   stepPass(terms, diagnose);
+  if (m_FixedBoundary && !m_BoundaryVertices.empty())
+  {
+    this->HoldBoundary(coordinates.data(), &blockMaximum, diagnose);
+  }
   if (m_NumberOfSubSteps > 1)
   {
     // The displacement of the whole iteration; the internal force of the
@@ -1102,6 +1460,10 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
     this->BuildTopology(m_Triangles, edges, unique);
   }
   ++m_NumberOfRemeshings;
+  // The remesher never moves a boundary vertex and splits boundary edges at
+  // their midpoints: the new boundary vertices lie on the boundary curve and
+  // are held from now on.
+  this->FindBoundaryVertices(m_Triangles);
   // The collision test's tables for the new mesh (no check: see
   // ResetCollision()).
   this->ResetCollision(&m_Triangles, false);
@@ -1138,6 +1500,10 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "MaximumStepLength: " << m_MaximumStepLength << std::endl;
   os << indent << "ConvergenceTolerance: " << m_ConvergenceTolerance << std::endl;
   os << indent << "ConvergenceWindow: " << m_ConvergenceWindow << std::endl;
+  os << indent << "FixedBoundary: " << (m_FixedBoundary ? "On" : "Off") << " (" << m_BoundaryVertices.size()
+     << " boundary vertices)" << std::endl;
+  os << indent << "Contours: " << m_NumberOfClosedContours << " closed, " << m_NumberOfOpenContours << " open"
+     << " (first end " << m_FirstContourEnd << ")" << std::endl;
   os << indent << "PreventSelfIntersections: " << (m_PreventSelfIntersections ? "On" : "Off") << std::endl;
   os << indent << "MinimumDistance: " << m_MinimumDistance << std::endl;
   os << indent << "NumberOfCollisionsPrevented: " << m_NumberOfCollisionsPrevented << " (total "

@@ -48,7 +48,8 @@ static_assert(BlockSize % ChunkSize == 0, "blocks are made of whole chunks");
 /** How the neighbours of a vertex are stored: as the ordered ring of a
  * closed fan of triangles (interior vertex), as an open fan (boundary
  * vertex), or unordered with the vertex's triangles kept apart (any other
- * case: polygons, lines, non-manifold vertices). */
+ * case: polygons, lines, non-manifold vertices, and every vertex of a 2-D
+ * contour, whose segments are kept apart as its "triangles"). */
 enum RingKind : uint8_t
 {
   ClosedRing = 0,
@@ -86,6 +87,11 @@ struct MeshTables
   const uint32_t * generalPairOffsets; // CSR by rank in generalVertices
   const uint32_t * generalPairs;       // (b, c): edges opposite the vertex in its triangles
   const uint8_t *  valenceOrder;       // per chunk, offsets in valence order; null when unused
+  // 2-D contours (points (x, y, 0)): the pairs (b, c) of a GeneralVertex are
+  // then the directed segments b -> c of its contours, and its normal the sum
+  // of (c - b) x z (the right of the direction of travel: outward for a
+  // counter-clockwise closed contour).
+  bool contour{ false };
 };
 
 /** The weights of the terms of one step, as the step uses them (Elasticity

@@ -132,6 +132,7 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareImageTerms()
       }
       source = scaled;
     }
+    typename IntensityImageType::Pointer smoothed;
     if (m_RegionSigma > 0.0)
     {
       using SmoothingType = SmoothingRecursiveGaussianImageFilter<IntensityImageType, IntensityImageType>;
@@ -140,13 +141,48 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareImageTerms()
       smoothing->SetSigma(m_RegionSigma);
       smoothing->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
       smoothing->Update();
-      m_SmoothedIntensity = smoothing->GetOutput();
-      m_SmoothedIntensity->DisconnectPipeline();
+      smoothed = smoothing->GetOutput();
+      smoothed->DisconnectPipeline();
     }
     else
     {
-      m_SmoothedIntensity = IntensityImageType::New();
-      m_SmoothedIntensity->Graft(source);
+      smoothed = IntensityImageType::New();
+      smoothed->Graft(source);
+    }
+    if constexpr (PointDimension == 3)
+    {
+      m_SmoothedIntensity = smoothed;
+    }
+    else
+    {
+      // The slice z = 0 of a 3-D image (spacing 1 and direction identity
+      // along z): the samplers read it bilinearly at the points (x, y, 0).
+      const auto                                         region = smoothed->GetBufferedRegion();
+      typename SmoothedIntensityImageType::RegionType    region3;
+      typename SmoothedIntensityImageType::PointType     origin3;
+      typename SmoothedIntensityImageType::SpacingType   spacing3;
+      typename SmoothedIntensityImageType::DirectionType direction3;
+      direction3.SetIdentity();
+      for (unsigned int r = 0; r < 3; ++r)
+      {
+        region3.SetIndex(r, r < 2 ? region.GetIndex()[r] : 0);
+        region3.SetSize(r, r < 2 ? region.GetSize()[r] : 1);
+        origin3[r] = r < 2 ? smoothed->GetOrigin()[r] : 0.0;
+        spacing3[r] = r < 2 ? smoothed->GetSpacing()[r] : 1.0;
+        for (unsigned int c = 0; c < 2 && r < 2; ++c)
+        {
+          direction3(r, c) = smoothed->GetDirection()(r, c);
+        }
+      }
+      m_SmoothedIntensity = SmoothedIntensityImageType::New();
+      m_SmoothedIntensity->SetRegions(region3);
+      m_SmoothedIntensity->SetOrigin(origin3);
+      m_SmoothedIntensity->SetSpacing(spacing3);
+      m_SmoothedIntensity->SetDirection(direction3);
+      m_SmoothedIntensity->Allocate();
+      std::copy(smoothed->GetBufferPointer(),
+                smoothed->GetBufferPointer() + region.GetNumberOfPixels(),
+                m_SmoothedIntensity->GetBufferPointer());
     }
     m_SmoothedIntensitySource = image;
     m_SmoothedIntensityTime = image->GetMTime();
@@ -158,7 +194,11 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareImageTerms()
   }
   m_IntensitySampler.SetImage(m_SmoothedIntensity);
   const auto & spacing = image->GetSpacing();
-  m_BackgroundStep = std::min(spacing[0], std::min(spacing[1], spacing[2]));
+  m_BackgroundStep = spacing[0];
+  for (unsigned int d = 1; d < PointDimension; ++d)
+  {
+    m_BackgroundStep = std::min(m_BackgroundStep, spacing[d]);
+  }
 }
 
 template <typename TMesh, typename TForceImage>
@@ -319,11 +359,14 @@ DeformableMeshFilter<TMesh, TForceImage>::AddEdgeSearchSpeeds()
   }
   // An edge must drop by at least the object's robust standard deviation
   // (the transition width for a given range): noise inside the object does
-  // not make one.
-  const double contrast = (m_EstimateObjectIntensityRange || m_ObjectIntensityStatisticsGiven)
-                            ? m_ObjectIntensitySpread * m_IntensityScale
-                            : m_RegionForce.GetWidth();
-  EdgeSearch   search;
+  // not make one. And by at least 1 % of the image's intensity range: the
+  // object of a noise-free image has no spread, and the ripples of the
+  // smoothing (a millionth of the range) inside it are no edges.
+  const double contrast = std::max((m_EstimateObjectIntensityRange || m_ObjectIntensityStatisticsGiven)
+                                     ? m_ObjectIntensitySpread * m_IntensityScale
+                                     : m_RegionForce.GetWidth(),
+                                   0.01 * (m_IntensityQuantiles[1] - m_IntensityQuantiles[0]));
+  EdgeSearch search;
   search.Configure(m_EdgeSearchDistance, 0.5 * m_BackgroundStep, m_BackgroundStep, polarity, contrast);
 
   constexpr SizeValueType blockSize = 4096;

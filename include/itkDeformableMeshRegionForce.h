@@ -40,10 +40,14 @@ template <typename TImage>
 void
 PhysicalToIndexMatrix(const TImage * image, double matrix[3][3])
 {
+  // A 2-D image is the slice z = 0 of a 3-D one: index z is physical z.
+  constexpr unsigned int dimension = TImage::ImageDimension;
+  static_assert(dimension == 2 || dimension == 3, "2-D or 3-D images only");
   Matrix<double, 3, 3> indexToPhysical;
-  for (unsigned int r = 0; r < 3; ++r)
+  indexToPhysical.SetIdentity();
+  for (unsigned int r = 0; r < dimension; ++r)
   {
-    for (unsigned int c = 0; c < 3; ++c)
+    for (unsigned int c = 0; c < dimension; ++c)
     {
       indexToPhysical(r, c) = image->GetDirection()(r, c) * image->GetSpacing()[c];
     }
@@ -330,6 +334,7 @@ public:
     const size_t       sx = 1;
     const size_t       sy = size[0];
     const size_t       sz = size[0] * size[1];
+    const bool         flat = size[2] == 1;
     const size_t       count = image->GetBufferedRegion().GetNumberOfPixels();
     const size_t       stride = std::max<size_t>(1, count / 1000000) | 1;
     std::vector<float> values;
@@ -339,13 +344,14 @@ public:
       const size_t i = offset % size[0];
       const size_t j = (offset / size[0]) % size[1];
       const size_t k = offset / sz;
-      if (i == 0 || j == 0 || k == 0 || i + 1 >= size[0] || j + 1 >= size[1] || k + 1 >= size[2])
+      // One slice (a 2-D image embedded in 3-D): no z gradient.
+      if (i == 0 || j == 0 || i + 1 >= size[0] || j + 1 >= size[1] || (!flat && (k == 0 || k + 1 >= size[2])))
       {
         continue;
       }
       const double gx = (buffer[offset + sx] - buffer[offset - sx]) / (2.0 * spacing[0]);
       const double gy = (buffer[offset + sy] - buffer[offset - sy]) / (2.0 * spacing[1]);
-      const double gz = (buffer[offset + sz] - buffer[offset - sz]) / (2.0 * spacing[2]);
+      const double gz = flat ? 0.0 : (buffer[offset + sz] - buffer[offset - sz]) / (2.0 * spacing[2]);
       const double magnitude = std::sqrt(gx * gx + gy * gy + gz * gz);
       if (std::isfinite(magnitude))
       {

@@ -21,6 +21,7 @@
 #include "itkMeshToMeshFilter.h"
 #include "itkExplicitDeformableModelCompatibility.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -66,8 +67,9 @@ namespace itk
  * keeps the input's numbering then.
  *
  * Subclasses implement Iterate() on the coordinate cache (GetCoordinates(): a
- * flat array of N * PointDimension doubles in physical units, point after
- * point) and may override Reset() and HasConverged().
+ * flat array of N * GetCoordinateStride() doubles in physical units, point
+ * after point; the stride is PointDimension unless the subclass asks for more,
+ * the extra coordinates being 0) and may override Reset() and HasConverged().
  *
  * \sa BrownianMeshFilter, DeformableMeshFilter
  * \ingroup ExplicitDeformableModel
@@ -158,9 +160,11 @@ protected:
     return false;
   }
 
-  /** The cached coordinates: N * PointDimension doubles, point after point.
-   * A subclass may append values of its own after them (in Reset()) or swap
-   * in an array of its own; only the first N * PointDimension are read. */
+  /** The cached coordinates: N * GetCoordinateStride() doubles, point after
+   * point (the point's PointDimension coordinates, then zeros up to the
+   * stride). A subclass may append values of its own after them (in Reset())
+   * or swap in an array of its own; only the first N * GetCoordinateStride()
+   * are read. */
   std::vector<double> &
   GetCoordinates()
   {
@@ -170,6 +174,20 @@ protected:
   GetCoordinates() const
   {
     return m_Coordinates;
+  }
+
+  /** Doubles per cached point: PointDimension unless the subclass set more
+   * (SetCoordinateStride(), in its constructor): a subclass whose step works
+   * on 3-D vectors caches a 2-D point as (x, y, 0). */
+  unsigned int
+  GetCoordinateStride() const
+  {
+    return m_CoordinateStride;
+  }
+  void
+  SetCoordinateStride(unsigned int stride)
+  {
+    m_CoordinateStride = std::max(stride, PointDimension);
   }
 
   /** Number of points of the cached mesh. */
@@ -237,6 +255,7 @@ private:
   bool                m_Cached{ false };
   ModifiedTimeType    m_CachedInputTime{ 0 };
   std::vector<double> m_Coordinates;
+  unsigned int        m_CoordinateStride{ PointDimension };
   SizeValueType       m_NumberOfCachedPoints{ 0 };
   SizeValueType       m_NumberOfInputPoints{ 0 }; // of the input when it was cached
   bool                m_OutputPointsFinite{ true };

@@ -74,7 +74,7 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::CacheInput()
   const SizeValueType   numberOfPoints = points->Size();
 
   m_NumberOfCachedPoints = 0;
-  m_Coordinates.assign(numberOfPoints * PointDimension, 0.0);
+  m_Coordinates.assign(numberOfPoints * m_CoordinateStride, 0.0);
   SizeValueType expectedId = 0;
   for (auto it = points->Begin(); it != points->End(); ++it, ++expectedId)
   {
@@ -92,7 +92,7 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::CacheInput()
         itkExceptionMacro("The input mesh has a non-finite coordinate (NaN or infinity) at point #" << expectedId
                                                                                                     << ".");
       }
-      m_Coordinates[expectedId * PointDimension + d] = value;
+      m_Coordinates[expectedId * m_CoordinateStride + d] = value;
     }
   }
   m_NumberOfCachedPoints = numberOfPoints;
@@ -124,14 +124,14 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::ThrowNonFiniteCoordinate(SizeValue
 {
   // The next update starts again from the input.
   m_Cached = false;
-  const SizeValueType n = this->GetNumberOfCachedPoints() * PointDimension;
+  const SizeValueType n = this->GetNumberOfCachedPoints() * m_CoordinateStride;
   SizeValueType       i = 0;
   while (i < n && std::isfinite(m_Coordinates[i]))
   {
     ++i;
   }
   const double        value = i < n ? m_Coordinates[i] : std::numeric_limits<double>::quiet_NaN();
-  const SizeValueType point = i / PointDimension;
+  const SizeValueType point = i / m_CoordinateStride;
   const SizeValueType pointId =
     point < m_OutputPointIdentifiers.size() ? static_cast<SizeValueType>(m_OutputPointIdentifiers[point]) : point;
   itkExceptionMacro("Point #" << pointId << " has a non-finite coordinate (" << value << ") after iteration "
@@ -259,7 +259,8 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::UpdateOutputPoints()
   const double *   x = m_Coordinates.data();
   double           check = 0.0;
   const uint32_t * ids = m_OutputPointIdentifiers.size() == numberOfPoints ? m_OutputPointIdentifiers.data() : nullptr;
-  for (SizeValueType i = 0; i < numberOfPoints; ++i, x += PointDimension)
+  const unsigned int stride = m_CoordinateStride;
+  for (SizeValueType i = 0; i < numberOfPoints; ++i, x += stride)
   {
     OutputPointType & p = elements[ids ? ids[i] : i];
     for (unsigned int d = 0; d < PointDimension; ++d)
@@ -358,7 +359,8 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::PrintSelf(std::ostream & os, Inden
   os << indent << "CachedInputTime: " << m_CachedInputTime << std::endl;
   os << indent << "OutputCells: " << (m_OutputCells ? m_OutputCells->Size() : 0) << " shared cells" << std::endl;
   os << indent << "OutputPoints: " << (m_OutputPoints ? m_OutputPoints->Size() : 0) << " reusable points" << std::endl;
-  os << indent << "Coordinates: " << this->GetNumberOfCachedPoints() << " cached points" << std::endl;
+  os << indent << "Coordinates: " << this->GetNumberOfCachedPoints() << " cached points, " << m_CoordinateStride
+     << " values each" << std::endl;
   os << indent << "OutputPointsFinite: " << (m_OutputPointsFinite ? "true" : "false") << std::endl;
   os << indent << "NumberOfInputPoints: " << m_NumberOfInputPoints << std::endl;
   os << indent << "TopologyChanged: " << (m_TopologyChanged ? "true" : "false") << ", " << m_CachedTriangles.size() / 3
