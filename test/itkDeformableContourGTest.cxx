@@ -919,6 +919,45 @@ using Mesh3Type = itk::Mesh<double, 3, itk::DefaultStaticMeshTraits<double, 3, 3
 using Image3Type = itk::Image<float, 3>;
 using Force3Type = itk::Image<itk::CovariantVector<float, 3>, 3>;
 using Filter3Type = itk::DeformableMeshFilter<Mesh3Type, Force3Type>;
+using EdgeType = std::pair<itk::IdentifierType, itk::IdentifierType>;
+
+/** The boundary edges of a triangle mesh, counted independently of the
+ * filter: the edges of one triangle. */
+std::vector<EdgeType>
+BoundaryEdges(const Mesh3Type * mesh)
+{
+  std::map<EdgeType, int> edgeCount;
+  for (auto it = mesh->GetCells()->Begin(); it != mesh->GetCells()->End(); ++it)
+  {
+    const auto * ids = it.Value()->PointIdsBegin();
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      ++edgeCount[std::minmax(ids[k], ids[(k + 1) % 3])];
+    }
+  }
+  std::vector<EdgeType> boundary;
+  for (const auto & e : edgeCount)
+  {
+    if (e.second == 1)
+    {
+      boundary.push_back(e.first);
+    }
+  }
+  return boundary;
+}
+
+/** The points of the edges given. */
+std::set<itk::IdentifierType>
+EdgePoints(const std::vector<EdgeType> & edges)
+{
+  std::set<itk::IdentifierType> points;
+  for (const auto & e : edges)
+  {
+    points.insert(e.first);
+    points.insert(e.second);
+  }
+  return points;
+}
 } // namespace
 
 TEST(DeformableContour, OpenSurfaceWithFixedOrFreeBoundary)
@@ -991,24 +1030,8 @@ TEST(DeformableContour, OpenSurfaceWithFixedOrFreeBoundary)
     }
   }
   // The rim, counted independently: the points of edges of one triangle.
-  std::map<std::pair<itk::IdentifierType, itk::IdentifierType>, int> edgeCount;
-  for (auto it = disk->GetCells()->Begin(); it != disk->GetCells()->End(); ++it)
-  {
-    const auto * ids = it.Value()->PointIdsBegin();
-    for (unsigned int k = 0; k < 3; ++k)
-    {
-      ++edgeCount[std::minmax(ids[k], ids[(k + 1) % 3])];
-    }
-  }
-  std::set<itk::IdentifierType> rim;
-  for (const auto & e : edgeCount)
-  {
-    if (e.second == 1)
-    {
-      rim.insert(e.first.first);
-      rim.insert(e.first.second);
-    }
-  }
+  const std::vector<EdgeType>         rimEdges = BoundaryEdges(disk);
+  const std::set<itk::IdentifierType> rim = EdgePoints(rimEdges);
   ASSERT_GT(rim.size(), 30u);
   const itk::IdentifierType middle = static_cast<itk::IdentifierType>(id[10][10]);
 
@@ -1070,32 +1093,7 @@ TEST(DeformableContour, OpenSurfaceWithFixedOrFreeBoundary)
     const auto & p = disk->GetPoint(i);
     EXPECT_EQ(outputPoints.count({ p[0], p[1], p[2] }), 1u) << "rim point " << i;
   }
-  std::vector<std::pair<itk::IdentifierType, itk::IdentifierType>> rimEdges;
-  for (const auto & e : edgeCount)
-  {
-    if (e.second == 1)
-    {
-      rimEdges.push_back(e.first);
-    }
-  }
-  std::map<std::pair<itk::IdentifierType, itk::IdentifierType>, int> outputEdges;
-  for (auto it = out->GetCells()->Begin(); it != out->GetCells()->End(); ++it)
-  {
-    const auto * ids = it.Value()->PointIdsBegin();
-    for (unsigned int k = 0; k < 3; ++k)
-    {
-      ++outputEdges[std::minmax(ids[k], ids[(k + 1) % 3])];
-    }
-  }
-  std::set<itk::IdentifierType> outputRim;
-  for (const auto & e : outputEdges)
-  {
-    if (e.second == 1)
-    {
-      outputRim.insert(e.first.first);
-      outputRim.insert(e.first.second);
-    }
-  }
+  const std::set<itk::IdentifierType> outputRim = EdgePoints(BoundaryEdges(out));
   EXPECT_EQ(filter->GetNumberOfBoundaryVertices(), outputRim.size());
   EXPECT_GT(outputRim.size(), rim.size());
   for (const auto i : outputRim)

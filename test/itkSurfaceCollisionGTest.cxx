@@ -268,6 +268,39 @@ Flatten(const MeshType * mesh, std::vector<double> & x, std::vector<uint32_t> & 
   }
   itk::SurfaceCollision::ExtractTriangles(mesh, triangles);
 }
+
+/** Two parallel squares of side 6 at z = 0 and z = gap, each a grid of
+ * 13 x 13 points (edges 0.5) cut into 288 triangles, the upper one shifted
+ * by (0.13, 0.07) in its plane: 3 doubles a point in x, 3 indices a triangle
+ * in triangles; the upper sheet's points are the second half. */
+void
+TwoSheets(double gap, std::vector<double> & x, std::vector<uint32_t> & triangles)
+{
+  const unsigned int m = 12;
+  x.clear();
+  triangles.clear();
+  for (unsigned int sheet = 0; sheet < 2; ++sheet)
+  {
+    const auto base = static_cast<uint32_t>(x.size() / 3);
+    for (unsigned int j = 0; j <= m; ++j)
+    {
+      for (unsigned int i = 0; i <= m; ++i)
+      {
+        x.push_back(0.5 * i + (sheet ? 0.13 : 0.0));
+        x.push_back(0.5 * j + (sheet ? 0.07 : 0.0));
+        x.push_back(sheet ? gap : 0.0);
+      }
+    }
+    for (unsigned int j = 0; j < m; ++j)
+    {
+      for (unsigned int i = 0; i < m; ++i)
+      {
+        const uint32_t p = base + j * (m + 1) + i;
+        triangles.insert(triangles.end(), { p, p + 1, p + m + 2, p, p + m + 2, p + m + 1 });
+      }
+    }
+  }
+}
 } // namespace
 
 // ---------------------------------------------------------------------------
@@ -452,30 +485,9 @@ TEST(SurfaceCollision, ConstrainStopsFrontsPushedThroughEachOther)
   // the other in one step, with a few vertices pushed further: without the
   // constraint they cross; constrained, none intersects and no pair is
   // closer than d, nor did the sheets move where they are clear.
-  const unsigned int    m = 12;
   std::vector<double>   x;
   std::vector<uint32_t> triangles;
-  for (unsigned int sheet = 0; sheet < 2; ++sheet)
-  {
-    const auto base = static_cast<uint32_t>(x.size() / 3);
-    for (unsigned int j = 0; j <= m; ++j)
-    {
-      for (unsigned int i = 0; i <= m; ++i)
-      {
-        x.push_back(0.5 * i + (sheet ? 0.13 : 0.0));
-        x.push_back(0.5 * j + (sheet ? 0.07 : 0.0));
-        x.push_back(sheet ? 2.0 : 0.0);
-      }
-    }
-    for (unsigned int j = 0; j < m; ++j)
-    {
-      for (unsigned int i = 0; i < m; ++i)
-      {
-        const uint32_t p = base + j * (m + 1) + i;
-        triangles.insert(triangles.end(), { p, p + 1, p + m + 2, p, p + m + 2, p + m + 1 });
-      }
-    }
-  }
+  TwoSheets(2.0, x, triangles);
   const std::size_t   n = x.size() / 3;
   std::vector<double> y = x;
   for (std::size_t i = 0; i < n; ++i)
@@ -528,30 +540,9 @@ TEST(SurfaceCollision, RandomStepsNeverBringPairsCloserThanD)
   // no intersecting pair and no pair closer than d, by this file's all-pairs
   // test. A translation moves no triangle relative to another: the second of
   // two translations keeps the index (the first may follow a rebuild).
-  const unsigned int    m = 12;
   std::vector<double>   x;
   std::vector<uint32_t> triangles;
-  for (unsigned int sheet = 0; sheet < 2; ++sheet)
-  {
-    const auto base = static_cast<uint32_t>(x.size() / 3);
-    for (unsigned int j = 0; j <= m; ++j)
-    {
-      for (unsigned int i = 0; i <= m; ++i)
-      {
-        x.push_back(0.5 * i + (sheet ? 0.13 : 0.0));
-        x.push_back(0.5 * j + (sheet ? 0.07 : 0.0));
-        x.push_back(sheet ? 1.0 : 0.0);
-      }
-    }
-    for (unsigned int j = 0; j < m; ++j)
-    {
-      for (unsigned int i = 0; i < m; ++i)
-      {
-        const uint32_t p = base + j * (m + 1) + i;
-        triangles.insert(triangles.end(), { p, p + 1, p + m + 2, p, p + m + 2, p + m + 1 });
-      }
-    }
-  }
+  TwoSheets(1.0, x, triangles);
   const std::size_t n = x.size() / 3;
   const double      d = 0.1;
   ASSERT_GE(CheckAllPairs(x, triangles, d).smallestDistance, d);
