@@ -862,12 +862,17 @@ TEST(DeformableContour, BadInputRaisesClearExceptions)
     cell->SetPointId(1, 1);
     bad->SetCell(0, cell);
     expectError(bad, nothing, { "closed contour of 2", "at least 3" });
+    // A mesh of its own (a cell set again under the same identifier would
+    // not be released by the mesh).
+    auto shortLine = MeshType::New();
+    shortLine->SetPoint(0, Point(10.0, 10.0));
+    shortLine->SetPoint(1, Point(12.0, 10.0));
     CellType::CellAutoPointer line;
     line.TakeOwnership(new LineType);
     line->SetPointId(0, 1);
     line->SetPointId(1, 1);
-    bad->SetCell(0, line);
-    expectError(bad, nothing, { "contour of 1", "at least 2" });
+    shortLine->SetCell(0, line);
+    expectError(shortLine, nothing, { "contour of 1", "at least 2" });
   }
   // Surface cells in a 2-D mesh.
   {
