@@ -31,6 +31,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <limits>
 #include <map>
@@ -861,24 +862,34 @@ CheckImageData(const std::string & path, const itk::ImageIOBase * io)
   }
 }
 
-/** Spacing and origin that the physical-space computations can hold. */
+/** Spacing and origin that the physical-space computations can hold (the
+ * first three axes, or the two of a 2-D image). */
 void
 CheckImageGeometry(const std::string & path, const itk::ImageIOBase * io)
 {
-  for (unsigned int d = 0; d < 3; ++d)
+  const unsigned int dimension = std::min(3u, io->GetNumberOfDimensions());
+  const auto         list = [dimension](const std::function<double(unsigned int)> & value, const char * separator) {
+    std::string text;
+    for (unsigned int d = 0; d < dimension; ++d)
+    {
+      text += (d == 0 ? "" : separator) + FormatNumber(value(d));
+    }
+    return text;
+  };
+  for (unsigned int d = 0; d < dimension; ++d)
   {
     const double spacing = io->GetSpacing(d);
     if (!(spacing >= 1e-9 && spacing <= 1e9))
     {
-      throw Error("image " + Quote(path) + " has spacing " + FormatNumber(io->GetSpacing(0)) + " x " +
-                  FormatNumber(io->GetSpacing(1)) + " x " + FormatNumber(io->GetSpacing(2)) +
+      throw Error("image " + Quote(path) + " has spacing " +
+                  list([io](unsigned int k) { return io->GetSpacing(k); }, " x ") +
                   ": edmodel needs spacings between 1e-09 and 1e+09 (physical units per voxel)");
     }
     const double origin = io->GetOrigin(d);
     if (!(std::abs(origin) <= 1e12))
     {
-      throw Error("image " + Quote(path) + " has origin " + FormatNumber(io->GetOrigin(0)) + ", " +
-                  FormatNumber(io->GetOrigin(1)) + ", " + FormatNumber(io->GetOrigin(2)) +
+      throw Error("image " + Quote(path) + " has origin " +
+                  list([io](unsigned int k) { return io->GetOrigin(k); }, ", ") +
                   ": edmodel needs coordinates within 1e+12 of 0");
     }
   }
@@ -902,8 +913,9 @@ CheckMemoryForImage(const std::string & path, const std::vector<size_t> & size, 
 }
 
 /** The first voxel of \a image that is not finite, as an Error. */
+template <typename TImage>
 void
-CheckFiniteVoxels(const std::string & path, const ImageType * image)
+CheckFiniteVoxels(const std::string & path, const TImage * image)
 {
   const float *            voxels = image->GetBufferPointer();
   const itk::SizeValueType n = image->GetBufferedRegion().GetNumberOfPixels();
@@ -911,19 +923,25 @@ CheckFiniteVoxels(const std::string & path, const ImageType * image)
   {
     if (!std::isfinite(voxels[i]))
     {
-      const auto index = image->ComputeIndex(static_cast<itk::OffsetValueType>(i));
+      const auto  index = image->ComputeIndex(static_cast<itk::OffsetValueType>(i));
+      std::string where;
+      for (unsigned int d = 0; d < TImage::ImageDimension; ++d)
+      {
+        where += (d == 0 ? "" : ", ") + std::to_string(index[d]);
+      }
       throw Error("image " + Quote(path) + " has a non-finite value (" + FormatNumber(voxels[i]) + ") at voxel (" +
-                  std::to_string(index[0]) + ", " + std::to_string(index[1]) + ", " + std::to_string(index[2]) + ")");
+                  where + ")");
     }
   }
 }
 
 /** Double images are read as double and checked against the float range that
  * edmodel computes in (a cast would turn 1e300 into infinity). */
-ImageType::Pointer
+template <typename TImage>
+typename TImage::Pointer
 ReadDoubleImage(const std::string & path, itk::ImageIOBase * io)
 {
-  using DoubleImageType = itk::Image<double, 3>;
+  using DoubleImageType = itk::Image<double, TImage::ImageDimension>;
   auto reader = itk::ImageFileReader<DoubleImageType>::New();
   reader->SetImageIO(io);
   reader->SetFileName(path);
@@ -939,7 +957,7 @@ ReadDoubleImage(const std::string & path, itk::ImageIOBase * io)
     }
   }
   const DoubleImageType * input = reader->GetOutput();
-  auto                    image = ImageType::New();
+  auto                    image = TImage::New();
   image->CopyInformation(input);
   image->SetRegions(input->GetBufferedRegion());
   image->Allocate();
@@ -1071,7 +1089,7 @@ ReadDicomSeries(const std::string & directory)
     throw Error("image " + Quote(directory) + " is 2-D (" + DescribeSize({ size[0], size[1] }) +
                 ", one DICOM slice): edmodel needs a 3-D volume");
   }
-  CheckFiniteVoxels(directory, image);
+  CheckFiniteVoxels(directory, image.GetPointer());
   return image;
 }
 
@@ -1953,14 +1971,12 @@ GetExtension(const std::string & path)
   return dot == std::string::npos || dot == 0 ? std::string() : name.substr(dot);
 }
 
-ImageType::Pointer
-ReadImage(const std::string & path, bool gradientVectorFlow)
+namespace
 {
-  std::error_code error;
-  if (fs::is_directory(path, error))
-  {
-    return ReadDicomSeries(path);
-  }
+/** The ImageIO that reads \a path, its header read; Error when none does. */
+itk::ImageIOBase::Pointer
+OpenImage(const std::string & path)
+{
   RequireRegularFile(path, "image");
   itk::ImageIOBase::Pointer io;
   {
@@ -1984,38 +2000,44 @@ ReadImage(const std::string & path, bool gradientVectorFlow)
       throw Error("cannot read image " + Quote(path) + ": " + Describe(exception, captured.Text()));
     }
   }
+  return io;
+}
+
+std::vector<size_t>
+ImageSize(const itk::ImageIOBase * io)
+{
   std::vector<size_t> size;
-  unsigned int        extent = 0; // dimensions of more than one voxel
   for (unsigned int d = 0; d < io->GetNumberOfDimensions(); ++d)
   {
     size.push_back(io->GetDimensions(d));
-    extent += io->GetDimensions(d) > 1 ? 1 : 0;
   }
-  const bool flat = size.size() < 3 || size[0] < 2 || size[1] < 2 || size[2] < 2;
-  if (flat && extent <= 2)
-  {
-    throw Error("image " + Quote(path) + " is 2-D (" + DescribeSize(size) + "): edmodel needs a 3-D volume");
-  }
-  if (flat || extent > 3)
-  {
-    throw Error("image " + Quote(path) + " is " + std::to_string(size.size()) + "-D (" + DescribeSize(size) +
-                "): edmodel needs a 3-D volume");
-  }
+  return size;
+}
+
+/** The voxels of an image whose header \a io has read and whose size was
+ * checked, as float, after the checks of geometry, memory and data. */
+template <typename TImage>
+typename TImage::Pointer
+ReadImagePixels(const std::string & path, itk::ImageIOBase * io, bool gradientVectorFlow)
+{
   CheckImageGeometry(path, io);
   // The file's pixels, the float image, the force filter's float images and
   // field (and the diffusion's arrays with gradient vector flow).
   const double filePixel = static_cast<double>(io->GetComponentSize() * io->GetNumberOfComponents());
-  CheckMemoryForImage(path, size, filePixel + 4.0 + 40.0 + (gradientVectorFlow ? 40.0 : 0.0));
+  constexpr double dimension = TImage::ImageDimension;
+  CheckMemoryForImage(path,
+                      ImageSize(io),
+                      filePixel + 4.0 + (40.0 + (gradientVectorFlow ? 40.0 : 0.0)) * dimension / 3.0);
   CheckImageData(path, io);
 
-  ImageType::Pointer image;
+  typename TImage::Pointer image;
   if (io->GetComponentType() == itk::IOComponentEnum::DOUBLE && io->GetNumberOfComponents() == 1)
   {
-    image = ReadDoubleImage(path, io);
+    image = ReadDoubleImage<TImage>(path, io);
   }
   else
   {
-    auto reader = itk::ImageFileReader<ImageType>::New();
+    auto reader = itk::ImageFileReader<TImage>::New();
     reader->SetImageIO(io);
     reader->SetFileName(path);
     CapturedOutput captured;
@@ -2030,8 +2052,80 @@ ReadImage(const std::string & path, bool gradientVectorFlow)
     image = reader->GetOutput();
     image->DisconnectPipeline();
   }
-  CheckFiniteVoxels(path, image);
+  CheckFiniteVoxels(path, image.GetPointer());
   return image;
+}
+} // namespace
+
+ImageType::Pointer
+ReadImage(const std::string & path, bool gradientVectorFlow)
+{
+  std::error_code error;
+  if (fs::is_directory(path, error))
+  {
+    return ReadDicomSeries(path);
+  }
+  itk::ImageIOBase::Pointer io = OpenImage(path);
+  const std::vector<size_t> size = ImageSize(io);
+  unsigned int              extent = 0; // dimensions of more than one voxel
+  for (const auto n : size)
+  {
+    extent += n > 1 ? 1 : 0;
+  }
+  const bool flat = size.size() < 3 || size[0] < 2 || size[1] < 2 || size[2] < 2;
+  if (flat && extent <= 2)
+  {
+    throw Error("image " + Quote(path) + " is 2-D (" + DescribeSize(size) + "): edmodel needs a 3-D volume");
+  }
+  if (flat || extent > 3)
+  {
+    throw Error("image " + Quote(path) + " is " + std::to_string(size.size()) + "-D (" + DescribeSize(size) +
+                "): edmodel needs a 3-D volume");
+  }
+  return ReadImagePixels<ImageType>(path, io, gradientVectorFlow);
+}
+
+ImageInfo
+ReadImageInfo(const std::string & path)
+{
+  ImageInfo       info;
+  std::error_code error;
+  if (fs::is_directory(path, error))
+  {
+    info.dimension = 3; // a DICOM series
+    return info;
+  }
+  itk::ImageIOBase::Pointer io = OpenImage(path);
+  info.size = ImageSize(io);
+  info.description = DescribeSize(info.size);
+  unsigned int extent = 0;
+  for (const auto n : info.size)
+  {
+    extent += n > 1 ? 1 : 0;
+  }
+  info.dimension = extent <= 2 ? 2 : extent;
+  return info;
+}
+
+Image2DType::Pointer
+ReadImage2D(const std::string & path, bool gradientVectorFlow)
+{
+  itk::ImageIOBase::Pointer io = OpenImage(path);
+  const std::vector<size_t> size = ImageSize(io);
+  // A 2-D image, or a volume of one slice along its third axis (and any
+  // later axes of one voxel): the reader keeps the first two axes.
+  bool plane = size.size() >= 2 && size[0] >= 2 && size[1] >= 2;
+  for (size_t d = 2; d < size.size(); ++d)
+  {
+    plane = plane && size[d] == 1;
+  }
+  if (!plane)
+  {
+    throw Error("image " + Quote(path) + " is " + DescribeSize(size) +
+                ": a 2-D image needs at least 2 x 2 pixels, and a volume of one slice its slice across the third "
+                "axis (N x M x 1)");
+  }
+  return ReadImagePixels<Image2DType>(path, io, gradientVectorFlow);
 }
 
 size_t
@@ -2162,6 +2256,62 @@ ReadMesh(const std::string & path, const std::string & option)
   MeshType::Pointer mesh = reader->GetOutput();
   mesh->DisconnectPipeline();
   return CheckSurfaceMesh(mesh, path, option);
+}
+
+MeshType::Pointer
+ReadCurveMesh(const std::string & path, const std::string & option)
+{
+  RequireRegularFile(path, "contour");
+  const std::string extension = GetExtension(path);
+  MeshType::Pointer mesh;
+  try
+  {
+    if (extension == ".vtk")
+    {
+      mesh = ReadLegacyVTK(path);
+    }
+    else if (extension == ".vtp")
+    {
+      if (!HasVTK())
+      {
+        throw Error("reading .vtp needs VTK, and this edmodel was built without VTK (use .csv or .vtk)");
+      }
+      try
+      {
+        CapturedOutput captured;
+        mesh = ReadPolyDataMesh(path);
+      }
+      catch (const itk::ExceptionObject & exception)
+      {
+        throw Error("cannot read contour " + Quote(path) + ": " + OneLine(exception.GetDescription()));
+      }
+    }
+    else
+    {
+      throw Error("unknown contour extension '" + extension + "' in " + Quote(path) + " (use .csv, .vtk or .vtp)");
+    }
+  }
+  catch (const Error & error)
+  {
+    if (std::string(error.what()).compare(0, option.size(), option) == 0)
+    {
+      throw;
+    }
+    throw Error(option + ": " + error.what());
+  }
+  for (auto it = mesh->GetPoints()->Begin(); it != mesh->GetPoints()->End(); ++it)
+  {
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      if (!(std::abs(it.Value()[k]) <= 1e12))
+      {
+        throw Error(option + ": contour " + Quote(path) + " has point " + std::to_string(it.Index()) + " at " +
+                    FormatNumber(it.Value()[0]) + ", " + FormatNumber(it.Value()[1]) + ", " +
+                    FormatNumber(it.Value()[2]) + ": edmodel needs finite coordinates within 1e+12 of 0");
+      }
+    }
+  }
+  return mesh;
 }
 
 void
@@ -2308,6 +2458,37 @@ WriteImage(const ForceImageType * image, const std::string & path)
       {
         out[i][k] = in[i][k];
       }
+    }
+    WriteAnyImage(vectors.GetPointer(), path);
+    return;
+  }
+  WriteAnyImage(image, path);
+}
+
+void
+WriteImage(const Image2DType * image, const std::string & path)
+{
+  WriteAnyImage(image, path);
+}
+
+void
+WriteImage(const Force2DType * image, const std::string & path)
+{
+  const std::string extension = GetExtension(path);
+  if (extension == ".nii" || extension == ".nii.gz")
+  {
+    using VectorImageType = itk::Image<itk::Vector<float, 2>, 2>;
+    auto vectors = VectorImageType::New();
+    vectors->CopyInformation(image);
+    vectors->SetRegions(image->GetBufferedRegion());
+    vectors->Allocate();
+    const auto *             in = image->GetBufferPointer();
+    auto *                   out = vectors->GetBufferPointer();
+    const itk::SizeValueType n = image->GetBufferedRegion().GetNumberOfPixels();
+    for (itk::SizeValueType i = 0; i < n; ++i)
+    {
+      out[i][0] = in[i][0];
+      out[i][1] = in[i][1];
     }
     WriteAnyImage(vectors.GetPointer(), path);
     return;

@@ -32,6 +32,39 @@ using MeshType = itk::Mesh<double, 3, itk::DefaultStaticMeshTraits<double, 3, 3,
 ImageType::Pointer
 ReadImage(const std::string & path, bool gradientVectorFlow = false);
 
+/** 2-D images and contours (edmodelContour.cxx). */
+using Image2DType = itk::Image<float, 2>;
+using Force2DType = itk::Image<itk::CovariantVector<float, 2>, 2>;
+using ContourMeshType = itk::Mesh<double, 2, itk::DefaultStaticMeshTraits<double, 2, 2, double, double, double>>;
+
+/** What the header of an image file says, read without its voxels. */
+struct ImageInfo
+{
+  /** 2 for a 2-D image or a volume of at most two axes longer than one voxel
+   * (a single slice), otherwise the number of such axes; 3 for a DICOM
+   * series directory. */
+  unsigned int        dimension{ 3 };
+  std::vector<size_t> size;
+  std::string         description; // "32 x 32", "24 x 24 x 1"
+};
+
+/** Reads the header of \a path. Throws Error (exit code 2) when the file is
+ * missing, not a regular file, or no ITK reader recognises it. */
+ImageInfo
+ReadImageInfo(const std::string & path);
+
+/** Reads a 2-D image (PNG, TIFF, JPEG, BMP, 2-D NIfTI, NRRD, MetaImage), or
+ * a volume of one slice across its third axis, as float, with the checks of
+ * ReadImage. Throws Error (exit code 2). */
+Image2DType::Pointer
+ReadImage2D(const std::string & path, bool gradientVectorFlow = false);
+
+/** Reads the points and cells of a curve file, .vtk (legacy POLYDATA) or
+ * .vtp (with VTK): no triangle needed. Throws Error, its message starting
+ * with \a option. */
+MeshType::Pointer
+ReadCurveMesh(const std::string & path, const std::string & option);
+
 /** Reads a surface mesh (.vtk, .obj, .off, .gii; .vtp and .stl with VTK). \a option names the
  * command-line option in messages. Throws Error when the file is missing,
  * unreadable, of an unknown format or has no triangle or polygon. Legacy .vtk,
@@ -92,6 +125,10 @@ void
 WriteImage(const ImageType * image, const std::string & path);
 void
 WriteImage(const ForceImageType * image, const std::string & path);
+void
+WriteImage(const Image2DType * image, const std::string & path);
+void
+WriteImage(const Force2DType * image, const std::string & path);
 
 /** A file written through a temporary directory beside it,
  * DIR/.edmodel-PID-K/NAME (same file system; a short directory name whatever

@@ -153,8 +153,9 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
     { io,
       "--image",
       "PATH",
-      "3-D image to segment: any file ITK reads (.nii, .nii.gz, .nrrd, .nhdr, .mha, .mhd, ...) or a directory "
-      "holding a DICOM series; any intensity range; required",
+      "image to segment: a 3-D image, any file ITK reads (.nii, .nii.gz, .nrrd, .nhdr, .mha, .mhd, ...) or a "
+      "directory holding a DICOM series; or a 2-D image (.png, .tif, 2-D .nii, .nrrd, .mha, or a volume of one "
+      "slice), segmented with a contour (see '2-D images' above); any intensity range; required",
       "",
       [&o](const std::string & s) { o.image = s; } });
   t.push_back({ io,
@@ -162,7 +163,8 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                 "MESH",
                 "deformed mesh, format chosen by extension: .vtk (legacy VTK), .obj, .off, .gii" +
                   std::string(HasVTK() ? ", .vtp, .stl" : " (.vtp and .stl need a build with VTK)") +
-                  "; coordinates in the image's physical frame (mm); required",
+                  "; of a 2-D image, the contour: .vtk or .vtp (polylines) or .csv (x,y per point); coordinates in "
+                  "the image's physical frame (mm); required",
                 "",
                 [&o](const std::string & s) { o.output = s; } });
   t.push_back(
@@ -200,6 +202,66 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                 "--init-sphere",
                 "",
                 [&o](const std::string & s) { o.initMesh = s; } });
+  t.push_back({ io,
+                "--init-circle",
+                "X,Y,R",
+                "2-D image: initial contour, a circle of centre (X,Y) and radius R in physical coordinates (mm), "
+                "inside the object; it must lie inside the image",
+                "centred in the image, radius " + FormatNumber(defaults::SphereRadiusOverExtent) +
+                  " x the smallest extent",
+                [&o](const std::string & s) {
+                  const auto v = ParseList("--init-circle", s, 3, "X,Y,R");
+                  for (unsigned int k = 0; k < 3; ++k)
+                  {
+                    o.circle[k] = v[k];
+                  }
+                  if (!(v[2] > 0.0))
+                  {
+                    throw Error("--init-circle: the radius must be positive, got " + FormatNumber(v[2]));
+                  }
+                  o.hasInitCircle = true;
+                } });
+  t.push_back({ io,
+                "--circle-points",
+                "N",
+                "2-D image: points of the initial circle, 8 to 100000 (refined until the mean edge is about "
+                "--edge-length)",
+                std::to_string(defaults::CirclePoints),
+                [&o](const std::string & s) {
+                  o.circlePoints = ParseUnsigned("--circle-points", s);
+                  RequireInRange("--circle-points", o.circlePoints, 8, 100000);
+                } });
+  t.push_back({ io,
+                "--init-contour",
+                "FILE",
+                "2-D image: initial contour(s) in physical coordinates (mm), instead of --init-circle: a .csv of x,y "
+                "points, one per line (a first line that is not numbers is a header, an empty line starts another "
+                "contour; closed unless --open), or the polylines and polygons of a .vtk" +
+                  std::string(HasVTK() ? " or .vtp" : "") +
+                  " (a polyline that ends on its first point is closed; z ignored)",
+                "",
+                [&o](const std::string & s) { o.initContour = s; } });
+  t.push_back({ io,
+                "--open",
+                "",
+                "the contours of the --init-contour .csv are open (the region force and the balloon then stay off: "
+                "outward is undefined)",
+                "closed",
+                [&o](const std::string &) { o.openContour = true; } });
+  t.push_back({ io,
+                "--fixed-boundary",
+                "",
+                "the ends of open contours and the boundary of open surfaces keep their initial position",
+                "off (they move)",
+                [&o](const std::string &) { o.fixedBoundary = true; } });
+  t.push_back({ io,
+                "--overlay-png",
+                "PNG",
+                "2-D image: also draw the initial (yellow) and final (red) contours over the image, in a PNG (the "
+                "image's intensities from its 0.5th to 99.5th percentile in grey, pixels shown with their aspect "
+                "ratio, enlarged to at least 512 pixels across)",
+                "",
+                [&o](const std::string & s) { o.overlayPng = s; } });
   t.push_back({ io,
                 "--force-output",
                 "IMG",
@@ -568,6 +630,7 @@ PrintMainHelp(std::ostream & os)
         "  edmodel demo --output-dir /tmp/edmodel-demo\n"
         "  edmodel segment --image liver.nii.gz --init-sphere 12.5,-40,80,15 --output liver.vtk\n"
         "  edmodel segment --image dicom/ --init-mesh start.obj --balloon 0.1 --output surface.off\n"
+        "  edmodel segment --image slice.png --init-circle 60,40,8 --output contour.csv --overlay-png over.png\n"
         "\n"
         "Exit status: 0 success, 1 poor result or internal error, 2 bad command line or input.\n";
 }
@@ -576,10 +639,20 @@ void
 PrintSegmentHelp(std::ostream & os, const OptionTable & table)
 {
   os << "Usage: edmodel segment --image IMG --output MESH [--init-sphere X,Y,Z,R | --init-mesh MESH] [options]\n"
+        "       edmodel segment --image IMG2D --output CONTOUR [--init-circle X,Y,R | --init-contour FILE] [options]\n"
         "\n"
         "Computes the external force field of IMG, deforms the initial surface under it and writes the\n"
         "result. Lengths are in physical units (mm); coordinates in the image's physical frame (origin,\n"
-        "spacing and direction honoured). The defaults need no tuning for images of any intensity range.\n";
+        "spacing and direction honoured). The defaults need no tuning for images of any intensity range.\n"
+        "\n"
+        "2-D images (a 2-D file, or a volume of one slice): the model is a contour (a snake), started from\n"
+        "--init-circle X,Y,R or --init-contour FILE instead of a sphere or a mesh, with the same filters,\n"
+        "options and defaults (a circle of --circle-points points refined to --edge-length; the region\n"
+        "force estimated inside the initial circle). --output .vtk/.vtp/.csv writes the contour, and\n"
+        "--overlay-png draws it over the image. An open contour (--open, or an open polyline) has no\n"
+        "region force or balloon; --fixed-boundary keeps its ends. --init-sphere and --init-mesh need a\n"
+        "3-D image, --init-circle and --init-contour a 2-D one.\n"
+        "  edmodel segment --image cells.png --init-circle 120,80,15 --output cell.csv --overlay-png cell.png\n";
   PrintOptions(os, table);
 }
 
@@ -736,8 +809,22 @@ Main(const std::vector<std::string> & args)
     {
       throw Error("segment: --every needs --snapshots DIR");
     }
+    const bool contour = options.hasInitCircle || !options.initContour.empty();
+    if (options.hasInitCircle && !options.initContour.empty())
+    {
+      throw Error("segment: give --init-circle or --init-contour, not both");
+    }
+    if (contour && (options.hasInitSphere || !options.initMesh.empty()))
+    {
+      throw Error(std::string("segment: give a 2-D initial contour (--init-circle, --init-contour) or a 3-D initial ") +
+                  "surface (--init-sphere, --init-mesh), not both");
+    }
+    if (options.openContour && options.initContour.empty())
+    {
+      throw Error("segment: --open applies to the contours of --init-contour FILE.csv");
+    }
     // An output that is an input would replace it.
-    const std::vector<std::string> inputs{ options.image, options.initMesh };
+    const std::vector<std::string> inputs{ options.image, options.initMesh, options.initContour };
     CheckNotAnInput(options.output, "--output", inputs);
     if (!options.forceOutput.empty())
     {
@@ -749,7 +836,48 @@ Main(const std::vector<std::string> & args)
         throw Error("--force-output: '" + options.forceOutput + "' is also the --output mesh");
       }
     }
+    if (!options.overlayPng.empty())
+    {
+      CheckNotAnInput(options.overlayPng, "--overlay-png", inputs);
+    }
+    // The image's dimension chooses the model: a contour in 2-D, a surface in
+    // 3-D. An image whose header cannot be read goes the 3-D way, which
+    // reports it after checking the outputs, as it always has.
+    unsigned int dimension = 3;
+    std::string  description;
+    try
+    {
+      const ImageInfo info = ReadImageInfo(options.image);
+      dimension = info.dimension;
+      description = info.description;
+    }
+    catch (const Error &)
+    {
+      dimension = contour ? 2 : 3;
+    }
+    const std::string image = "'" + options.image + "'";
+    if (dimension == 2 && (options.hasInitSphere || !options.initMesh.empty()))
+    {
+      throw Error(std::string(options.hasInitSphere ? "--init-sphere" : "--init-mesh") + " needs a 3-D image: " +
+                  image + " is 2-D (" + description + "); use --init-circle X,Y,R or --init-contour FILE");
+    }
+    if (dimension != 2 && contour)
+    {
+      throw Error(std::string(options.hasInitCircle ? "--init-circle" : "--init-contour") + " needs a 2-D image: " +
+                  image + " is " + std::to_string(dimension) + "-D" +
+                  (description.empty() ? std::string() : " (" + description + ")") +
+                  "; use --init-sphere X,Y,Z,R or --init-mesh FILE");
+    }
+    if (dimension != 2 && !options.overlayPng.empty())
+    {
+      throw Error("--overlay-png draws a contour over a 2-D image: " + image + " is " + std::to_string(dimension) +
+                  "-D" + (description.empty() ? std::string() : " (" + description + ")"));
+    }
     SetNumberOfThreads(global.threads);
+    if (dimension == 2)
+    {
+      return RunSegmentContour(options, global);
+    }
     return RunSegment(options, global);
   }
   if (command == "demo")

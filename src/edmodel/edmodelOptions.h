@@ -70,6 +70,10 @@ constexpr unsigned int SphereResolution = 4;
  * physical extent of the image. */
 constexpr double       SphereRadiusOverExtent = 0.25;
 constexpr unsigned int SnapshotEvery = 10;
+/** Points of the initial circle of --init-circle (2-D): the coarse level of
+ * the contour, refined like the sphere (each edge split in two) until its
+ * mean edge is about --edge-length. */
+constexpr unsigned int CirclePoints = 64;
 /** Region force: largest inflation or deflation per iteration, as a fraction
  * of the smallest voxel spacing, and the smoothing of its image in voxels. */
 constexpr double RegionWeightInVoxels = 0.25;
@@ -140,6 +144,14 @@ struct SegmentOptions
   bool         hasInitSphere{ false };
   double       sphere[4]{ 0.0, 0.0, 0.0, 0.0 }; // centre x, y, z and radius
   unsigned int sphereResolution{ defaults::SphereResolution };
+  // 2-D images (edmodelContour.cxx).
+  bool         hasInitCircle{ false };
+  double       circle[3]{ 0.0, 0.0, 0.0 }; // centre x, y and radius
+  unsigned int circlePoints{ defaults::CirclePoints };
+  std::string  initContour;
+  bool         openContour{ false };
+  std::string  overlayPng;
+  bool         fixedBoundary{ false };
 
   double       sigma{ -1.0 }; // negative: defaults::SigmaInVoxels times the smallest spacing
   double       scale{ -1.0 }; // negative: defaults::ScaleOverSigma times sigma
@@ -180,6 +192,9 @@ int
 RunSegment(const SegmentOptions & options, const GlobalOptions & global);
 int
 RunDemo(const DemoOptions & options, const GlobalOptions & global);
+/** 'segment' on a 2-D image: a contour (edmodelContour.cxx). */
+int
+RunSegmentContour(const SegmentOptions & options, const GlobalOptions & global);
 
 /** Applies --threads to ITK's threaders (before any filter is created). */
 void

@@ -6,6 +6,7 @@
 #include "itkSurfaceCollision.h"
 #include "edmodelIO.h"
 #include "edmodelOptions.h"
+#include "edmodelProgress.h"
 
 #include "itkDeformableMeshFilter.h"
 #include "itkEllipsoidPhantom.h"
@@ -52,90 +53,6 @@ FormatPoint(const double * p, unsigned int n)
   }
   return text + ")";
 }
-
-/** Progress on stderr: a bar redrawn in place on a terminal, a plain line
- * every tenth otherwise, nothing with --quiet. */
-class Progress
-{
-public:
-  explicit Progress(bool quiet)
-    : m_Enabled(!quiet)
-    , m_Terminal(isatty(fileno(stderr)) != 0)
-  {}
-
-  void
-  Start(const std::string & stage)
-  {
-    m_Stage = stage;
-    m_LastTenth = -1;
-    m_LastDraw = std::chrono::steady_clock::time_point();
-    m_Drawn = false;
-  }
-
-  void
-  Update(double fraction, const std::string & detail)
-  {
-    if (!m_Enabled)
-    {
-      return;
-    }
-    fraction = std::min(1.0, std::max(0.0, fraction));
-    if (m_Terminal)
-    {
-      const auto now = std::chrono::steady_clock::now();
-      if (fraction < 1.0 && m_Drawn && now - m_LastDraw < std::chrono::milliseconds(100))
-      {
-        return;
-      }
-      m_LastDraw = now;
-      m_Drawn = true;
-      constexpr int width = 30;
-      const int     filled = static_cast<int>(fraction * width + 0.5);
-      std::cerr << "\r\033[K" << m_Stage << " [" << std::string(filled, '#') << std::string(width - filled, '.') << "] "
-                << std::setw(3) << static_cast<int>(fraction * 100.0 + 0.5) << "%  " << detail << std::flush;
-      return;
-    }
-    const int tenth = static_cast<int>(fraction * 10.0 + 1e-9);
-    if (tenth > m_LastTenth)
-    {
-      m_LastTenth = tenth;
-      std::cerr << "edmodel: " << m_Stage << " " << std::setw(3) << tenth * 10 << "%" << (detail.empty() ? "" : "  ")
-                << detail << std::endl;
-    }
-  }
-
-  /** Ends the stage with a summary line. */
-  void
-  Finish(const std::string & summary)
-  {
-    if (!m_Enabled)
-    {
-      return;
-    }
-    if (m_Terminal && m_Drawn)
-    {
-      std::cerr << "\r\033[K";
-    }
-    std::cerr << "edmodel: " << m_Stage << ": " << summary << std::endl;
-  }
-
-  void
-  Note(const std::string & text)
-  {
-    if (m_Enabled)
-    {
-      std::cerr << "edmodel: " << text << std::endl;
-    }
-  }
-
-private:
-  bool                                  m_Enabled;
-  bool                                  m_Terminal;
-  std::string                           m_Stage;
-  int                                   m_LastTenth{ -1 };
-  bool                                  m_Drawn{ false };
-  std::chrono::steady_clock::time_point m_LastDraw;
-};
 
 double
 SmallestSpacing(const ImageType * image)
@@ -587,6 +504,7 @@ Deform(const ImageType *        image,
     deform->SetPreventSelfIntersections(o.preventSelfIntersections);
     deform->SetMinimumDistance(o.minimumDistance);
     deform->SetMaximumStepLength(o.maximumStepLength);
+    deform->SetFixedBoundary(o.fixedBoundary);
     deform->SetConvergenceTolerance(o.convergenceTolerance);
     deform->SetConvergenceWindow(o.convergenceWindow);
     deform->SetNumberOfIterations(o.iterations);

@@ -10,6 +10,13 @@
 //   edmodelTestTool sphere MESH --center X,Y,Z --radius R [--resolution N]
 //   edmodelTestTool lines MESH          (points and lines: no triangle)
 //   edmodelTestTool flat IMG            (a 2-D image)
+//   edmodelTestTool ellipse2d IMG --size X,Y --spacing X,Y --origin X,Y --center X,Y --radii A,B
+//                   [--angle RAD] [--inside V] [--outside V] [--pixel uchar|float] [--slab 1]
+//                   (anti-aliased 2-D ellipse, the a-axis at RAD from x; --slab: a volume of one slice)
+//   edmodelTestTool measure-contour CONTOUR(.csv|.vtk) --center X,Y --radii A,B [--angle RAD]
+//                   --max-mean D --max-max D [--min-points N]
+//   edmodelTestTool check-overlay PNG --min-size N --min-red N
+//                   (an RGB PNG at least N pixels across, with at least N red contour pixels)
 //   edmodelTestTool measure MESH --center X,Y,Z --radii A,B,C [--axes 9 numbers]
 //                   --max-mean D --max-max D [--min-points N]
 //
@@ -23,10 +30,16 @@
 #include "itkMesh.h"
 #include "itkMeshFileReader.h"
 #include "itkMeshFileWriter.h"
+#include "itkImageFileReader.h"
+#include "itkImageRegionIteratorWithIndex.h"
 #include "itkMetaDataObject.h"
+#include "itkRGBPixel.h"
 
+#include <cmath>
 #include <cstdlib>
+#include <array>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -283,6 +296,193 @@ WriteFlat(const std::string & path)
   writer->Update();
 }
 
+// --- 2-D ----------------------------------------------------------------------
+
+/** Anti-aliased 2-D ellipse: each pixel holds the fraction of its 16 x 16
+ * sub-samples inside, between --outside and --inside. */
+template <typename TPixel, unsigned int VDimension>
+void
+WriteEllipse2D(const std::string & path, const std::map<std::string, std::string> & options)
+{
+  using ImageType = itk::Image<TPixel, VDimension>;
+  const auto   size = Numbers(options, "--size", 2);
+  const auto   spacing = Numbers(options, "--spacing", 2);
+  const auto   origin = Numbers(options, "--origin", 2);
+  const auto   c = Numbers(options, "--center", 2);
+  const auto   r = Numbers(options, "--radii", 2);
+  const double angle = options.count("--angle") ? std::stod(options.at("--angle")) : 0.0;
+  const double inside = options.count("--inside") ? std::stod(options.at("--inside")) : 200.0;
+  const double outside = options.count("--outside") ? std::stod(options.at("--outside")) : 40.0;
+  typename ImageType::SizeType    imageSize;
+  typename ImageType::SpacingType imageSpacing;
+  typename ImageType::PointType   imageOrigin;
+  imageSize.Fill(1);
+  imageSpacing.Fill(1.0);
+  imageOrigin.Fill(0.0);
+  for (unsigned int k = 0; k < 2; ++k)
+  {
+    imageSize[k] = static_cast<itk::SizeValueType>(size[k]);
+    imageSpacing[k] = spacing[k];
+    imageOrigin[k] = origin[k];
+  }
+  auto image = ImageType::New();
+  image->SetRegions(imageSize);
+  image->SetSpacing(imageSpacing);
+  image->SetOrigin(imageOrigin);
+  image->Allocate();
+  constexpr unsigned int sub = 16;
+  for (itk::ImageRegionIteratorWithIndex<ImageType> it(image, image->GetBufferedRegion()); !it.IsAtEnd(); ++it)
+  {
+    unsigned int count = 0;
+    for (unsigned int a = 0; a < sub; ++a)
+    {
+      for (unsigned int b = 0; b < sub; ++b)
+      {
+        const double x = origin[0] + (it.GetIndex()[0] - 0.5 + (a + 0.5) / sub) * spacing[0] - c[0];
+        const double y = origin[1] + (it.GetIndex()[1] - 0.5 + (b + 0.5) / sub) * spacing[1] - c[1];
+        const double u = std::cos(angle) * x + std::sin(angle) * y;
+        const double v = -std::sin(angle) * x + std::cos(angle) * y;
+        count += (u / r[0]) * (u / r[0]) + (v / r[1]) * (v / r[1]) <= 1.0 ? 1 : 0;
+      }
+    }
+    const double fraction = static_cast<double>(count) / (sub * sub);
+    it.Set(static_cast<TPixel>(std::lround(1000.0 * (outside + (inside - outside) * fraction)) / 1000.0));
+  }
+  auto writer = itk::ImageFileWriter<ImageType>::New();
+  writer->SetInput(image);
+  writer->SetFileName(path);
+  writer->Update();
+}
+
+/** The points of a contour written by edmodel: .csv (x,y lines after a
+ * header) or legacy .vtk (its POINTS section). */
+std::vector<std::array<double, 2>>
+ReadContourPoints(const std::string & path)
+{
+  std::ifstream                      stream(path);
+  std::vector<std::array<double, 2>> points;
+  if (!stream)
+  {
+    throw std::runtime_error("cannot read " + path);
+  }
+  if (path.size() > 4 && path.compare(path.size() - 4, 4, ".csv") == 0)
+  {
+    std::string line;
+    std::getline(stream, line); // header
+    while (std::getline(stream, line))
+    {
+      if (line.empty())
+      {
+        continue;
+      }
+      const auto comma = line.find(',');
+      points.push_back({ std::stod(line.substr(0, comma)), std::stod(line.substr(comma + 1)) });
+    }
+    return points;
+  }
+  std::string word;
+  while (stream >> word && word != "POINTS")
+  {}
+  size_t n = 0;
+  stream >> n >> word;
+  for (size_t i = 0; i < n; ++i)
+  {
+    double x = 0.0;
+    double y = 0.0;
+    double z = 0.0;
+    stream >> x >> y >> z;
+    points.push_back({ x, y });
+  }
+  if (!stream)
+  {
+    throw std::runtime_error("cannot read the POINTS of " + path);
+  }
+  return points;
+}
+
+/** Mean and largest distance of a contour's points to the ellipse, by dense
+ * sampling refined by golden-section search (exact to 1e-9 mm). */
+int
+MeasureContour(const std::string & path, const std::map<std::string, std::string> & options)
+{
+  const auto   c = Numbers(options, "--center", 2);
+  const auto   r = Numbers(options, "--radii", 2);
+  const double angle = options.count("--angle") ? std::stod(options.at("--angle")) : 0.0;
+  const auto   curve = [&](double t) {
+    const double u = r[0] * std::cos(t);
+    const double v = r[1] * std::sin(t);
+    return std::array<double, 2>{ c[0] + std::cos(angle) * u - std::sin(angle) * v,
+                                  c[1] + std::sin(angle) * u + std::cos(angle) * v };
+  };
+  const auto distance = [](const std::array<double, 2> & a, const std::array<double, 2> & b) {
+    return std::hypot(a[0] - b[0], a[1] - b[1]);
+  };
+  constexpr unsigned int samples = 20000;
+  constexpr double       twoPi = 6.283185307179586;
+  const auto             points = ReadContourPoints(path);
+  double                 mean = 0.0;
+  double                 maximum = 0.0;
+  for (const auto & p : points)
+  {
+    unsigned int best = 0;
+    double       bestDistance = 1e300;
+    for (unsigned int k = 0; k < samples; ++k)
+    {
+      const double d = distance(p, curve(twoPi * k / samples));
+      if (d < bestDistance)
+      {
+        bestDistance = d;
+        best = k;
+      }
+    }
+    double lo = twoPi * (best - 1.0) / samples;
+    double hi = twoPi * (best + 1.0) / samples;
+    for (unsigned int step = 0; step < 60; ++step)
+    {
+      const double m1 = lo + (hi - lo) * 0.381966;
+      const double m2 = hi - (hi - lo) * 0.381966;
+      if (distance(p, curve(m1)) < distance(p, curve(m2)))
+      {
+        hi = m2;
+      }
+      else
+      {
+        lo = m1;
+      }
+    }
+    const double d = std::min(bestDistance, distance(p, curve(0.5 * (lo + hi))));
+    mean += d;
+    maximum = std::max(maximum, d);
+  }
+  mean /= std::max<size_t>(1, points.size());
+  const double maxMean = Numbers(options, "--max-mean", 1)[0];
+  const double maxMax = Numbers(options, "--max-max", 1)[0];
+  const double minPoints = options.count("--min-points") ? std::stod(options.at("--min-points")) : 3.0;
+  std::cout << path << ": " << points.size() << " points; distance to the ellipse: mean " << mean << " mm, max "
+            << maximum << " mm (limits " << maxMean << ", " << maxMax << ")" << std::endl;
+  return mean <= maxMean && maximum <= maxMax && points.size() >= minPoints ? EXIT_SUCCESS : EXIT_FAILURE;
+}
+
+int
+CheckOverlay(const std::string & path, const std::map<std::string, std::string> & options)
+{
+  using RGBImageType = itk::Image<itk::RGBPixel<unsigned char>, 2>;
+  auto reader = itk::ImageFileReader<RGBImageType>::New();
+  reader->SetFileName(path);
+  reader->Update();
+  const auto * image = reader->GetOutput();
+  const auto   size = image->GetLargestPossibleRegion().GetSize();
+  size_t       red = 0;
+  for (itk::ImageRegionConstIterator<RGBImageType> it(image, image->GetBufferedRegion()); !it.IsAtEnd(); ++it)
+  {
+    red += it.Get()[0] == 255 && it.Get()[1] == 0 && it.Get()[2] == 0 ? 1 : 0;
+  }
+  const double minSize = Numbers(options, "--min-size", 1)[0];
+  const double minRed = Numbers(options, "--min-red", 1)[0];
+  std::cout << path << ": " << size[0] << " x " << size[1] << " pixels, " << red << " red" << std::endl;
+  return std::max(size[0], size[1]) >= minSize && red >= minRed ? EXIT_SUCCESS : EXIT_FAILURE;
+}
+
 } // namespace
 
 int
@@ -338,6 +538,28 @@ main(int argc, char * argv[])
     {
       WriteFlat(path);
       return EXIT_SUCCESS;
+    }
+    if (command == "ellipse2d")
+    {
+      const bool        slab = options.count("--slab") != 0;
+      const std::string pixel = options.count("--pixel") ? options.at("--pixel") : "float";
+      if (pixel == "uchar")
+      {
+        slab ? WriteEllipse2D<unsigned char, 3>(path, options) : WriteEllipse2D<unsigned char, 2>(path, options);
+      }
+      else
+      {
+        slab ? WriteEllipse2D<float, 3>(path, options) : WriteEllipse2D<float, 2>(path, options);
+      }
+      return EXIT_SUCCESS;
+    }
+    if (command == "measure-contour")
+    {
+      return MeasureContour(path, options);
+    }
+    if (command == "check-overlay")
+    {
+      return CheckOverlay(path, options);
     }
     if (command == "measure")
     {

@@ -1,0 +1,1316 @@
+/*=========================================================================
+ *
+ *  Copyright NumFOCUS
+ *
+ *  Licensed under the Apache License, Version 2.0 (the "License");
+ *  you may not use this file except in compliance with the License.
+ *  You may obtain a copy of the License at
+ *
+ *         http://www.apache.org/licenses/LICENSE-2.0.txt
+ *
+ *  Unless required by applicable law or agreed to in writing, software
+ *  distributed under the License is distributed on an "AS IS" BASIS,
+ *  WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+ *  See the License for the specific language governing permissions and
+ *  limitations under the License.
+ *
+ *=========================================================================*/
+
+// 'edmodel segment' on a 2-D image: the same pipeline as in 3-D
+// (ExternalForceImageFilter -> DeformableMeshFilter, region force estimated
+// inside the initial contour, coarse to fine) on a contour. The contours
+// are read and written here (.csv, .vtk, .vtp) and drawn over the image in
+// a PNG. No deformation maths here: the filters do it.
+
+#include "edmodelIO.h"
+#include "edmodelOptions.h"
+#include "edmodelProgress.h"
+
+#include "itkDeformableMeshFilter.h"
+#include "itkExternalForceImageFilter.h"
+#include "itkImageFileWriter.h"
+#include "itkLineCell.h"
+#include "itkPolygonCell.h"
+#include "itkRGBPixel.h"
+
+#ifdef EDM_HAVE_VTK
+#  include "vtkCellArray.h"
+#  include "vtkNew.h"
+#  include "vtkPoints.h"
+#  include "vtkPolyData.h"
+#  include "vtkXMLPolyDataWriter.h"
+#endif
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iomanip>
+#include <map>
+#include <memory>
+#include <set>
+#include <sstream>
+#include <vector>
+
+namespace edm
+{
+namespace
+{
+
+namespace fs = std::filesystem;
+
+using Force2DFilterType = itk::ExternalForceImageFilter<Image2DType, Force2DType>;
+using ContourFilterType = itk::DeformableMeshFilter<ContourMeshType, Force2DType>;
+using Point2 = ContourMeshType::PointType;
+
+/** One contour: its points in order, closed (the last joins the first) or
+ * open. */
+struct Contour
+{
+  std::vector<Point2> points;
+  bool                closed{ true };
+};
+using Contours = std::vector<Contour>;
+
+std::string
+Format(double value, int precision = 3)
+{
+  std::ostringstream stream;
+  stream << std::setprecision(precision) << value;
+  return stream.str();
+}
+
+std::string
+Quote(const std::string & path)
+{
+  return "'" + path + "'";
+}
+
+Point2
+MakePoint(double x, double y)
+{
+  Point2 p;
+  p[0] = x;
+  p[1] = y;
+  return p;
+}
+
+// --- The image's frame ------------------------------------------------------
+
+double
+SmallestSpacing(const Image2DType * image)
+{
+  return std::min(image->GetSpacing()[0], image->GetSpacing()[1]);
+}
+
+/** True when p falls within the image's pixels (half a pixel beyond the
+ * first and last pixel centres), widened by margin pixels on each side. */
+bool
+IsInsideImage(const Image2DType * image, const Point2 & p, double margin = 0.0)
+{
+  itk::ContinuousIndex<double, 2> index;
+  static_cast<void>(image->TransformPhysicalPointToContinuousIndex(p, index)); // the region test follows
+  const auto & region = image->GetLargestPossibleRegion();
+  for (unsigned int k = 0; k < 2; ++k)
+  {
+    const double low = static_cast<double>(region.GetIndex()[k]) - 0.5 - margin;
+    if (!(index[k] >= low && index[k] <= low + static_cast<double>(region.GetSize()[k]) + 2.0 * margin))
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+/** The physical bounding box of the image's pixels, for messages. */
+std::string
+DescribeBounds(const Image2DType * image)
+{
+  double     low[2] = { 1e300, 1e300 };
+  double     high[2] = { -1e300, -1e300 };
+  const auto region = image->GetLargestPossibleRegion();
+  for (unsigned int corner = 0; corner < 4; ++corner)
+  {
+    itk::ContinuousIndex<double, 2> index;
+    for (unsigned int k = 0; k < 2; ++k)
+    {
+      index[k] = region.GetIndex()[k] - 0.5 + ((corner >> k) & 1 ? region.GetSize()[k] : 0);
+    }
+    Point2 p;
+    image->TransformContinuousIndexToPhysicalPoint(index, p);
+    for (unsigned int k = 0; k < 2; ++k)
+    {
+      low[k] = std::min(low[k], p[k]);
+      high[k] = std::max(high[k], p[k]);
+    }
+  }
+  return "x " + Format(low[0], 6) + " to " + Format(high[0], 6) + ", y " + Format(low[1], 6) + " to " +
+         Format(high[1], 6) + " mm";
+}
+
+// --- Contours ---------------------------------------------------------------
+
+size_t
+CountPoints(const Contours & contours)
+{
+  size_t n = 0;
+  for (const auto & c : contours)
+  {
+    n += c.points.size();
+  }
+  return n;
+}
+
+size_t
+CountEdges(const Contour & c)
+{
+  return c.closed ? c.points.size() : c.points.size() - 1;
+}
+
+double
+Length(const Contour & c)
+{
+  double length = 0.0;
+  for (size_t k = 0; k < CountEdges(c); ++k)
+  {
+    length += c.points[k].EuclideanDistanceTo(c.points[(k + 1) % c.points.size()]);
+  }
+  return length;
+}
+
+double
+MeanEdgeLength(const Contours & contours)
+{
+  double length = 0.0;
+  size_t edges = 0;
+  for (const auto & c : contours)
+  {
+    length += Length(c);
+    edges += CountEdges(c);
+  }
+  return edges > 0 ? length / static_cast<double>(edges) : 0.0;
+}
+
+/** Area enclosed by a closed contour (absolute value), physical units. */
+double
+Area(const Contour & c)
+{
+  double twice = 0.0;
+  for (size_t k = 0; k < c.points.size(); ++k)
+  {
+    const auto & a = c.points[k];
+    const auto & b = c.points[(k + 1) % c.points.size()];
+    twice += a[0] * b[1] - a[1] * b[0];
+  }
+  return 0.5 * std::abs(twice);
+}
+
+/** Each edge split at its midpoint (the ends of open contours kept). */
+Contours
+Subdivide(const Contours & contours)
+{
+  Contours result;
+  for (const auto & c : contours)
+  {
+    Contour fine;
+    fine.closed = c.closed;
+    for (size_t k = 0; k < c.points.size(); ++k)
+    {
+      fine.points.push_back(c.points[k]);
+      if (k < CountEdges(c))
+      {
+        const auto & a = c.points[k];
+        const auto & b = c.points[(k + 1) % c.points.size()];
+        fine.points.push_back(MakePoint(0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])));
+      }
+    }
+    result.push_back(fine);
+  }
+  return result;
+}
+
+/** The contours as the filter's mesh: the points numbered contour after
+ * contour, a closed contour as one polygon cell, an open one as a chain of
+ * line cells. */
+ContourMeshType::Pointer
+ToMesh(const Contours & contours)
+{
+  using CellType = ContourMeshType::CellType;
+  auto                mesh = ContourMeshType::New();
+  auto                points = ContourMeshType::PointsContainer::New();
+  itk::IdentifierType next = 0;
+  itk::IdentifierType cellId = 0;
+  points->Reserve(CountPoints(contours));
+  for (const auto & c : contours)
+  {
+    const itk::IdentifierType first = next;
+    for (const auto & p : c.points)
+    {
+      points->SetElement(next++, p);
+    }
+    if (c.closed)
+    {
+      CellType::CellAutoPointer cell;
+      cell.TakeOwnership(new itk::PolygonCell<CellType>);
+      for (itk::IdentifierType k = 0; k < c.points.size(); ++k)
+      {
+        cell->SetPointId(static_cast<int>(k), first + k);
+      }
+      mesh->SetCell(cellId++, cell);
+    }
+    else
+    {
+      for (itk::IdentifierType k = 0; k + 1 < c.points.size(); ++k)
+      {
+        CellType::CellAutoPointer cell;
+        cell.TakeOwnership(new itk::LineCell<CellType>);
+        cell->SetPointId(0, first + k);
+        cell->SetPointId(1, first + k + 1);
+        mesh->SetCell(cellId++, cell);
+      }
+    }
+  }
+  mesh->SetPoints(points);
+  return mesh;
+}
+
+/** The filter's output back as contours of the layout of \a layout (the
+ * filter keeps the input's numbering). */
+Contours
+FromMesh(const ContourMeshType * mesh, const Contours & layout)
+{
+  Contours            result = layout;
+  itk::IdentifierType next = 0;
+  for (auto & c : result)
+  {
+    for (auto & p : c.points)
+    {
+      p = mesh->GetPoint(next++);
+    }
+  }
+  return result;
+}
+
+/** The contours as a 3-D mesh (z = 0) of line cells, for the .pvd series. */
+MeshType::Pointer
+ToSurfaceMesh(const Contours & contours)
+{
+  using CellType = MeshType::CellType;
+  auto                mesh = MeshType::New();
+  itk::IdentifierType next = 0;
+  itk::IdentifierType cellId = 0;
+  for (const auto & c : contours)
+  {
+    const itk::IdentifierType first = next;
+    for (const auto & p : c.points)
+    {
+      MeshType::PointType q;
+      q[0] = p[0];
+      q[1] = p[1];
+      q[2] = 0.0;
+      mesh->SetPoint(next++, q);
+    }
+    for (size_t k = 0; k < CountEdges(c); ++k)
+    {
+      CellType::CellAutoPointer cell;
+      cell.TakeOwnership(new itk::LineCell<CellType>);
+      cell->SetPointId(0, first + k);
+      cell->SetPointId(1, first + (k + 1) % c.points.size());
+      mesh->SetCell(cellId++, cell);
+    }
+  }
+  return mesh;
+}
+
+/** A contour with too few points, or points that are not finite, is bad
+ * input. */
+void
+CheckContour(const Contour & c, const std::string & what)
+{
+  std::set<std::pair<double, double>> distinct;
+  for (const auto & p : c.points)
+  {
+    if (!(std::abs(p[0]) <= 1e12 && std::abs(p[1]) <= 1e12))
+    {
+      throw Error(what + " has a point at " + Format(p[0], 6) + ", " + Format(p[1], 6) +
+                  ": edmodel needs finite coordinates within 1e+12 of 0");
+    }
+    distinct.insert({ p[0], p[1] });
+  }
+  const size_t needed = c.closed ? 3 : 2;
+  if (distinct.size() < needed)
+  {
+    throw Error(what + " has " + std::to_string(distinct.size()) + " distinct point" +
+                (distinct.size() == 1 ? "" : "s") + ": a" + (c.closed ? " closed" : "n open") + " contour needs " +
+                std::to_string(needed));
+  }
+}
+
+// --- Reading contours -------------------------------------------------------
+
+/** x,y points, one per line: a first line that is not numbers is a header,
+ * '#' starts a comment, an empty line ends a contour; separators ',', ';',
+ * spaces or tabs; a third number (z) is ignored. Closed contours unless
+ * \a open; a closed contour whose last point repeats its first drops it. */
+Contours
+ReadCsvContours(const std::string & path, bool open)
+{
+  std::ifstream stream(path, std::ios::binary);
+  if (!stream)
+  {
+    throw Error("--init-contour: cannot read contour " + Quote(path));
+  }
+  Contours    contours;
+  Contour     current;
+  std::string line;
+  size_t      number = 0;
+  bool        seenData = false;
+  const auto  finish = [&]() {
+    if (!current.points.empty())
+    {
+      current.closed = !open;
+      if (current.closed && current.points.size() > 1 &&
+          current.points.front().EuclideanDistanceTo(current.points.back()) == 0.0)
+      {
+        current.points.pop_back();
+      }
+      contours.push_back(current);
+      current = Contour();
+    }
+  };
+  while (std::getline(stream, line))
+  {
+    ++number;
+    if (number > 100000000)
+    {
+      throw Error("--init-contour: " + Quote(path) + " has more than 1e8 lines");
+    }
+    const auto hash = line.find('#');
+    if (hash != std::string::npos)
+    {
+      line.erase(hash);
+    }
+    for (auto & ch : line)
+    {
+      ch = (ch == ',' || ch == ';' || ch == '\t' || ch == '\r') ? ' ' : ch;
+    }
+    std::istringstream       fields(line);
+    std::vector<std::string> items;
+    std::string              item;
+    while (fields >> item)
+    {
+      items.push_back(item);
+    }
+    if (items.empty())
+    {
+      if (line.find_first_not_of(' ') == std::string::npos && hash == std::string::npos)
+      {
+        finish();
+      }
+      continue;
+    }
+    std::vector<double> values;
+    bool                numbers = items.size() == 2 || items.size() == 3;
+    for (const auto & text : items)
+    {
+      char *       end = nullptr;
+      const double value = std::strtod(text.c_str(), &end);
+      numbers = numbers && end != text.c_str() && *end == '\0';
+      values.push_back(value);
+    }
+    if (!numbers)
+    {
+      if (!seenData && contours.empty() && current.points.empty())
+      {
+        seenData = true; // the header
+        continue;
+      }
+      throw Error("--init-contour: " + Quote(path) + " line " + std::to_string(number) +
+                  ": expected x,y (two numbers), found '" + line + "'");
+    }
+    seenData = true;
+    if (!(std::isfinite(values[0]) && std::isfinite(values[1])))
+    {
+      throw Error("--init-contour: " + Quote(path) + " line " + std::to_string(number) + ": non-finite coordinate");
+    }
+    current.points.push_back(MakePoint(values[0], values[1]));
+  }
+  finish();
+  if (contours.empty())
+  {
+    throw Error("--init-contour: " + Quote(path) + " has no points");
+  }
+  return contours;
+}
+
+/** The curves of a mesh's line, polyline and polygon cells, followed from
+ * point to point: a chain with two ends is open, a loop is closed. A point
+ * with more than two neighbours (a branch) or a triangle is an error. */
+Contours
+ContoursFromMesh(const MeshType * mesh, const std::string & path)
+{
+  std::set<std::pair<itk::IdentifierType, itk::IdentifierType>> edges;
+  const auto addEdge = [&edges](itk::IdentifierType a, itk::IdentifierType b) {
+    if (a != b)
+    {
+      edges.insert({ std::min(a, b), std::max(a, b) });
+    }
+  };
+  if (mesh->GetCells() != nullptr)
+  {
+    for (auto it = mesh->GetCells()->Begin(); it != mesh->GetCells()->End(); ++it)
+    {
+      const auto * cell = it.Value();
+      const auto   type = cell->GetType();
+      const auto * ids = cell->GetPointIds();
+      const auto   n = cell->GetNumberOfPoints();
+      if (type == itk::CellGeometryEnum::LINE_CELL)
+      {
+        for (unsigned int k = 0; k + 1 < n; ++k)
+        {
+          addEdge(ids[k], ids[k + 1]);
+        }
+      }
+      else if (type == itk::CellGeometryEnum::POLYGON_CELL && n >= 3)
+      {
+        for (unsigned int k = 0; k < n; ++k)
+        {
+          addEdge(ids[k], ids[(k + 1) % n]);
+        }
+      }
+      else if (type == itk::CellGeometryEnum::TRIANGLE_CELL || type == itk::CellGeometryEnum::QUADRILATERAL_CELL)
+      {
+        throw Error("--init-contour: " + Quote(path) +
+                    " has triangles: a contour is made of polylines or polygons (a surface goes with --init-mesh on "
+                    "a 3-D image)");
+      }
+    }
+  }
+  if (edges.empty())
+  {
+    throw Error("--init-contour: " + Quote(path) + " has no lines or polygons");
+  }
+  std::map<itk::IdentifierType, std::vector<itk::IdentifierType>> neighbours;
+  for (const auto & e : edges)
+  {
+    neighbours[e.first].push_back(e.second);
+    neighbours[e.second].push_back(e.first);
+  }
+  for (const auto & entry : neighbours)
+  {
+    if (entry.second.size() > 2)
+    {
+      throw Error("--init-contour: " + Quote(path) + ": point " + std::to_string(entry.first) + " joins " +
+                  std::to_string(entry.second.size()) + " lines; contours must not branch");
+    }
+  }
+  std::set<itk::IdentifierType> visited;
+  Contours                      contours;
+  const auto                    follow = [&](itk::IdentifierType start, bool closed) {
+    Contour             c;
+    c.closed = closed;
+    itk::IdentifierType previous = start;
+    itk::IdentifierType current = start;
+    while (true)
+    {
+      visited.insert(current);
+      const auto & p = mesh->GetPoint(current);
+      c.points.push_back(MakePoint(p[0], p[1]));
+      bool moved = false;
+      for (const auto next : neighbours[current])
+      {
+        if (next != previous && visited.count(next) == 0)
+        {
+          previous = current;
+          current = next;
+          moved = true;
+          break;
+        }
+      }
+      if (!moved)
+      {
+        break;
+      }
+    }
+    contours.push_back(c);
+  };
+  for (const auto & entry : neighbours) // open chains, from an end
+  {
+    if (entry.second.size() == 1 && visited.count(entry.first) == 0)
+    {
+      follow(entry.first, false);
+    }
+  }
+  for (const auto & entry : neighbours) // the rest are loops
+  {
+    if (visited.count(entry.first) == 0)
+    {
+      follow(entry.first, true);
+    }
+  }
+  return contours;
+}
+
+Contours
+ReadInitialContours(const SegmentOptions & o)
+{
+  Contours contours;
+  if (GetExtension(o.initContour) == ".csv" || GetExtension(o.initContour) == ".txt")
+  {
+    std::error_code error;
+    if (!fs::is_regular_file(o.initContour, error))
+    {
+      throw Error("--init-contour: cannot read contour " + Quote(o.initContour) + ": " +
+                  (fs::exists(o.initContour, error) ? "not a regular file" : "no such file or directory"));
+    }
+    contours = ReadCsvContours(o.initContour, o.openContour);
+  }
+  else
+  {
+    if (o.openContour)
+    {
+      throw Error("--open applies to .csv contours: in " + Quote(o.initContour) +
+                  " a polyline is closed when it ends on its first point");
+    }
+    const MeshType::Pointer mesh = ReadCurveMesh(o.initContour, "--init-contour");
+    contours = ContoursFromMesh(mesh, o.initContour);
+  }
+  for (size_t k = 0; k < contours.size(); ++k)
+  {
+    CheckContour(contours[k],
+                 "--init-contour: " + Quote(o.initContour) +
+                   (contours.size() > 1 ? " contour " + std::to_string(k + 1) : std::string()));
+  }
+  return contours;
+}
+
+Contours
+MakeInitialCircle(const Image2DType * image, const SegmentOptions & o)
+{
+  Point2 center;
+  double radius = 0.0;
+  if (o.hasInitCircle)
+  {
+    center = MakePoint(o.circle[0], o.circle[1]);
+    radius = o.circle[2];
+    if (!IsInsideImage(image, center))
+    {
+      throw Error("--init-circle: the centre (" + Format(o.circle[0], 6) + ", " + Format(o.circle[1], 6) +
+                  ") is outside the image (" + DescribeBounds(image) + ")");
+    }
+  }
+  else
+  {
+    const auto &                    region = image->GetLargestPossibleRegion();
+    itk::ContinuousIndex<double, 2> middle;
+    double                          smallestExtent = 1e300;
+    for (unsigned int k = 0; k < 2; ++k)
+    {
+      middle[k] = region.GetIndex()[k] + 0.5 * (static_cast<double>(region.GetSize()[k]) - 1.0);
+      smallestExtent = std::min(smallestExtent, region.GetSize()[k] * image->GetSpacing()[k]);
+    }
+    image->TransformContinuousIndexToPhysicalPoint(middle, center);
+    radius = defaults::SphereRadiusOverExtent * smallestExtent;
+  }
+  Contour circle;
+  circle.closed = true;
+  for (unsigned int k = 0; k < o.circlePoints; ++k)
+  {
+    const double t = 2.0 * 3.141592653589793 * k / o.circlePoints;
+    circle.points.push_back(MakePoint(center[0] + radius * std::cos(t), center[1] + radius * std::sin(t)));
+    if (!IsInsideImage(image, circle.points.back()))
+    {
+      throw Error("--init-circle: the circle of centre (" + Format(center[0], 6) + ", " + Format(center[1], 6) +
+                  ") and radius " + Format(radius, 6) + " mm extends outside the image (" + DescribeBounds(image) +
+                  ")");
+    }
+  }
+  return { circle };
+}
+
+void
+CheckInitialContours(const Image2DType * image, const Contours & contours, const std::string & path, Progress & progress)
+{
+  size_t outside = 0;
+  for (const auto & c : contours)
+  {
+    for (const auto & p : c.points)
+    {
+      outside += IsInsideImage(image, p) ? 0 : 1;
+    }
+  }
+  const size_t n = CountPoints(contours);
+  if (outside == n)
+  {
+    throw Error("--init-contour: contour " + Quote(path) + " lies outside the image (" + DescribeBounds(image) + ")");
+  }
+  if (outside > 0)
+  {
+    progress.Note("warning: " + std::to_string(outside) + " of " + std::to_string(n) +
+                  " points of the initial contour are outside the image and feel no external force");
+  }
+}
+
+// --- Writing contours -------------------------------------------------------
+
+bool
+IsContourExtension(const std::string & extension)
+{
+  return extension == ".csv" || extension == ".vtk" || (extension == ".vtp" && HasVTK());
+}
+
+std::string
+ContourExtensionsText()
+{
+  return HasVTK() ? ".csv, .vtk or .vtp" : ".csv or .vtk (.vtp needs a build with VTK)";
+}
+
+void
+CheckOutputDirectoryOf(const std::string & path, const std::string & option)
+{
+  const fs::path  parent = fs::path(path).has_parent_path() ? fs::path(path).parent_path() : fs::path(".");
+  std::error_code error;
+  if (!fs::is_directory(parent, error))
+  {
+    throw Error(option + ": directory '" + parent.string() + "' does not exist");
+  }
+  if (fs::is_directory(path, error))
+  {
+    throw Error(option + ": " + Quote(path) + " is a directory");
+  }
+}
+
+void
+CheckContourOutputPath(const std::string & path, const std::string & option)
+{
+  const std::string extension = GetExtension(path);
+  if (!IsContourExtension(extension))
+  {
+    throw Error(option + ": " +
+                (extension == ".vtp" ? std::string("writing .vtp needs VTK, and this edmodel was built without VTK")
+                                     : "unknown contour extension '" + extension + "' in " + Quote(path)) +
+                " (a contour of a 2-D image is written as " + ContourExtensionsText() + ")");
+  }
+  CheckOutputDirectoryOf(path, option);
+}
+
+/** Coordinates printed so that a double reads back within 1e-12 relative. */
+std::string
+Coordinate(double value)
+{
+  std::ostringstream stream;
+  stream << std::setprecision(12) << value;
+  return stream.str();
+}
+
+/** x,y per line, a header, an empty line between contours. */
+std::string
+ContoursAsCsv(const Contours & contours)
+{
+  std::string text = "x,y\n";
+  for (size_t c = 0; c < contours.size(); ++c)
+  {
+    text += c == 0 ? "" : "\n";
+    for (const auto & p : contours[c].points)
+    {
+      text += Coordinate(p[0]) + "," + Coordinate(p[1]) + "\n";
+    }
+  }
+  return text;
+}
+
+/** Legacy VTK POLYDATA: the points (z = 0) and one polyline per contour,
+ * closed ones ending on their first point. */
+std::string
+ContoursAsLegacyVTK(const Contours & contours)
+{
+  std::string text = "# vtk DataFile Version 3.0\nedmodel contour\nASCII\nDATASET POLYDATA\nPOINTS " +
+                     std::to_string(CountPoints(contours)) + " double\n";
+  for (const auto & c : contours)
+  {
+    for (const auto & p : c.points)
+    {
+      text += Coordinate(p[0]) + " " + Coordinate(p[1]) + " 0\n";
+    }
+  }
+  size_t size = 0;
+  for (const auto & c : contours)
+  {
+    size += 1 + c.points.size() + (c.closed ? 1 : 0);
+  }
+  text += "LINES " + std::to_string(contours.size()) + " " + std::to_string(size) + "\n";
+  size_t first = 0;
+  for (const auto & c : contours)
+  {
+    text += std::to_string(c.points.size() + (c.closed ? 1 : 0));
+    for (size_t k = 0; k < c.points.size(); ++k)
+    {
+      text += " " + std::to_string(first + k);
+    }
+    text += c.closed ? " " + std::to_string(first) : std::string();
+    text += "\n";
+    first += c.points.size();
+  }
+  return text;
+}
+
+#ifdef EDM_HAVE_VTK
+std::string
+ContoursAsVTP(const Contours & contours)
+{
+  vtkObject::GlobalWarningDisplayOff();
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  vtkNew<vtkCellArray> lines;
+  vtkIdType            first = 0;
+  for (const auto & c : contours)
+  {
+    std::vector<vtkIdType> ids;
+    for (const auto & p : c.points)
+    {
+      points->InsertNextPoint(p[0], p[1], 0.0);
+      ids.push_back(first + static_cast<vtkIdType>(ids.size()));
+    }
+    if (c.closed)
+    {
+      ids.push_back(first);
+    }
+    lines->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
+    first += static_cast<vtkIdType>(c.points.size());
+  }
+  vtkNew<vtkPolyData> polyData;
+  polyData->SetPoints(points);
+  polyData->SetLines(lines);
+  vtkNew<vtkXMLPolyDataWriter> writer;
+  writer->SetInputData(polyData);
+  writer->WriteToOutputStringOn();
+  writer->SetDataModeToBinary(); // inline: ParaView 5.11 on Debian 12 cannot parse appended data
+  writer->SetCompressorTypeToZLib();
+  if (writer->Write() != 1)
+  {
+    throw Error("cannot write the contour as .vtp");
+  }
+  return writer->GetOutputString();
+}
+#endif
+
+void
+WriteContours(const Contours & contours, const std::string & path)
+{
+  const std::string extension = GetExtension(path);
+  std::string       text;
+  if (extension == ".csv")
+  {
+    text = ContoursAsCsv(contours);
+  }
+  else if (extension == ".vtk")
+  {
+    text = ContoursAsLegacyVTK(contours);
+  }
+  else
+  {
+#ifdef EDM_HAVE_VTK
+    text = ContoursAsVTP(contours);
+#else
+    throw Error("cannot write " + Quote(path) + ": this edmodel was built without VTK");
+#endif
+  }
+  AtomicOutput output(path);
+  WriteFileContents(text, output.GetTemporaryPath());
+  output.Commit();
+}
+
+// --- The overlay PNG --------------------------------------------------------
+
+using RGBPixelType = itk::RGBPixel<unsigned char>;
+using RGBImageType = itk::Image<RGBPixelType, 2>;
+
+/** The image in grey (its 0.5th to 99.5th percentile), each pixel drawn
+ * with its physical aspect ratio, enlarged to at least 512 pixels across,
+ * the initial contours in yellow and the final ones in red. */
+void
+WriteOverlay(const Image2DType * image, const Contours & initial, const Contours & final, const std::string & path)
+{
+  const auto   size = image->GetLargestPossibleRegion().GetSize();
+  const auto   start = image->GetLargestPossibleRegion().GetIndex();
+  const double smallest = SmallestSpacing(image);
+  // Width and height in pixels of the smallest spacing, then enlarged.
+  const double width = size[0] * image->GetSpacing()[0] / smallest;
+  const double height = size[1] * image->GetSpacing()[1] / smallest;
+  const double zoom = std::max(1.0, std::min(std::ceil(512.0 / std::max(width, height)), 4096.0 / std::max(width, height)));
+  RGBImageType::SizeType outputSize;
+  outputSize[0] = std::max<itk::SizeValueType>(1, static_cast<itk::SizeValueType>(std::lround(width * zoom)));
+  outputSize[1] = std::max<itk::SizeValueType>(1, static_cast<itk::SizeValueType>(std::lround(height * zoom)));
+
+  std::vector<float>       values(image->GetBufferPointer(),
+                            image->GetBufferPointer() + image->GetBufferedRegion().GetNumberOfPixels());
+  const auto               percentile = [&values](double q) {
+    const size_t k = static_cast<size_t>(q * static_cast<double>(values.size() - 1));
+    std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+    return static_cast<double>(values[k]);
+  };
+  double low = percentile(0.005);
+  double high = percentile(0.995);
+  if (!(high > low))
+  {
+    low = *std::min_element(values.begin(), values.end());
+    high = *std::max_element(values.begin(), values.end());
+  }
+  const double range = high > low ? high - low : 1.0;
+
+  auto overlay = RGBImageType::New();
+  overlay->SetRegions(outputSize);
+  overlay->Allocate();
+  const double scaleX = static_cast<double>(outputSize[0]) / size[0];
+  const double scaleY = static_cast<double>(outputSize[1]) / size[1];
+  for (itk::SizeValueType v = 0; v < outputSize[1]; ++v)
+  {
+    for (itk::SizeValueType u = 0; u < outputSize[0]; ++u)
+    {
+      Image2DType::IndexType index;
+      index[0] = start[0] + std::min<itk::IndexValueType>(size[0] - 1, static_cast<itk::IndexValueType>((u + 0.5) / scaleX));
+      index[1] = start[1] + std::min<itk::IndexValueType>(size[1] - 1, static_cast<itk::IndexValueType>((v + 0.5) / scaleY));
+      const double  t = std::min(1.0, std::max(0.0, (image->GetPixel(index) - low) / range));
+      const auto    grey = static_cast<unsigned char>(std::lround(255.0 * t));
+      RGBPixelType  pixel;
+      pixel.Set(grey, grey, grey);
+      RGBImageType::IndexType out = { { static_cast<itk::IndexValueType>(u), static_cast<itk::IndexValueType>(v) } };
+      overlay->SetPixel(out, pixel);
+    }
+  }
+
+  const auto draw = [&](const Contours & contours, RGBPixelType colour, double radius) {
+    const auto toOutput = [&](const Point2 & p, double & u, double & v) {
+      itk::ContinuousIndex<double, 2> index;
+      static_cast<void>(image->TransformPhysicalPointToContinuousIndex(p, index));
+      u = (index[0] - start[0] + 0.5) * scaleX - 0.5;
+      v = (index[1] - start[1] + 0.5) * scaleY - 0.5;
+    };
+    for (const auto & c : contours)
+    {
+      for (size_t k = 0; k < CountEdges(c); ++k)
+      {
+        double u0 = 0.0;
+        double v0 = 0.0;
+        double u1 = 0.0;
+        double v1 = 0.0;
+        toOutput(c.points[k], u0, v0);
+        toOutput(c.points[(k + 1) % c.points.size()], u1, v1);
+        const double length = std::hypot(u1 - u0, v1 - v0);
+        if (!(length < 1e6))
+        {
+          continue;
+        }
+        const int steps = static_cast<int>(std::ceil(2.0 * length)) + 1;
+        for (int s = 0; s <= steps; ++s)
+        {
+          const double u = u0 + (u1 - u0) * s / steps;
+          const double v = v0 + (v1 - v0) * s / steps;
+          for (long y = std::lround(v - radius); y <= std::lround(v + radius); ++y)
+          {
+            for (long x = std::lround(u - radius); x <= std::lround(u + radius); ++x)
+            {
+              if (x >= 0 && y >= 0 && x < static_cast<long>(outputSize[0]) && y < static_cast<long>(outputSize[1]) &&
+                  (x - u) * (x - u) + (y - v) * (y - v) <= radius * radius)
+              {
+                RGBImageType::IndexType out = { { x, y } };
+                overlay->SetPixel(out, colour);
+              }
+            }
+          }
+        }
+      }
+    }
+  };
+  const double lineRadius = std::max(1.0, std::min(outputSize[0], outputSize[1]) / 400.0);
+  RGBPixelType yellow;
+  yellow.Set(255, 220, 0);
+  RGBPixelType red;
+  red.Set(255, 0, 0);
+  draw(initial, yellow, 0.7 * lineRadius);
+  draw(final, red, lineRadius);
+
+  AtomicOutput output(path);
+  auto         writer = itk::ImageFileWriter<RGBImageType>::New();
+  writer->SetInput(overlay);
+  writer->SetFileName(output.GetTemporaryPath());
+  try
+  {
+    writer->Update();
+  }
+  catch (const itk::ExceptionObject & exception)
+  {
+    throw Error("cannot write " + Quote(path) + ": " + OneLine(exception.GetDescription()));
+  }
+  output.Commit();
+}
+
+// --- The deformation --------------------------------------------------------
+
+struct ContourResult
+{
+  Contours                contours;
+  Force2DType::Pointer    force;
+  itk::SizeValueType      iterations{ 0 };
+  bool                    converged{ false };
+  double                  lastMaximumDisplacement{ 0.0 };
+};
+
+using ContourSnapshot = std::function<void(const Contours &, itk::SizeValueType)>;
+
+bool
+HasOpenContour(const Contours & contours)
+{
+  return std::any_of(contours.begin(), contours.end(), [](const Contour & c) { return !c.closed; });
+}
+
+/** The force field and the deformation, by the ITK filters, with the
+ * schedule of the 3-D surfaces (edmodelPipeline.cxx): defaults from the
+ * smallest pixel spacing, the region force's intensity model estimated
+ * inside the initial contour, and coarse to fine (each edge split in two
+ * between levels) until the mean edge is about --edge-length. */
+ContourResult
+DeformContours(const Image2DType *     image,
+               const Contours &        initial,
+               const SegmentOptions &  o,
+               Progress &              progress,
+               const ContourSnapshot & snapshot)
+{
+  ContourResult result;
+  const double  smallest = SmallestSpacing(image);
+  const double  sigma = o.sigma >= 0.0 ? o.sigma : defaults::SigmaInVoxels * smallest;
+  const double  scale = o.scale >= 0.0 ? o.scale : defaults::ScaleOverSigma * (sigma > 0.0 ? sigma : smallest);
+
+  auto force = Force2DFilterType::New();
+  force->SetInput(image);
+  force->SetSigma(sigma);
+  force->SetNormalizeForces(o.normalizeForces);
+  force->SetUseGradientVectorFlow(o.gradientVectorFlow);
+  force->SetGradientVectorFlowRegularization(o.gradientVectorFlowRegularization);
+  force->SetGradientVectorFlowIterations(o.gradientVectorFlowIterations);
+  progress.Start("force field");
+  force->AddObserver(itk::ProgressEvent(),
+                     [&](const itk::EventObject &) { progress.Update(force->GetProgress(), ""); });
+  const auto start = std::chrono::steady_clock::now();
+  try
+  {
+    force->Update();
+  }
+  catch (const itk::ExceptionObject & exception)
+  {
+    throw Error("force field: " + OneLine(exception.GetDescription()));
+  }
+  result.force = force->GetOutput();
+  progress.Finish("sigma " + Format(sigma) + " mm" + (o.gradientVectorFlow ? ", gradient vector flow" : "") +
+                  (o.normalizeForces ? ", normalised" : ", not normalised") + " (" +
+                  Format(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2) + " s)");
+
+  // Outward is undefined on an open contour: no region force there.
+  const bool   open = HasOpenContour(initial);
+  const double regionWeight =
+    open ? 0.0 : o.regionWeight >= 0.0 ? o.regionWeight : defaults::RegionWeightInVoxels * smallest;
+  const double regionSigma = o.regionSigma >= 0.0 ? o.regionSigma : defaults::RegionSigmaInVoxels * smallest;
+  const double edgeSearchWeight =
+    open ? 0.0 : o.edgeSearchWeight >= 0.0 ? o.edgeSearchWeight : defaults::EdgeSearchWeightInVoxels * smallest;
+  const double edgeSearchDistance =
+    o.edgeSearchDistance > 0.0 ? o.edgeSearchDistance : defaults::EdgeSearchDistanceInVoxels * smallest;
+  const double edgeLength = o.edgeLength > 0.0 ? o.edgeLength : defaults::EdgeLengthInVoxels * smallest;
+  if (open && o.regionWeight < 0.0)
+  {
+    progress.Note("open contour: no region force (outward is undefined); gradient forces only");
+  }
+
+  Contours           stageInput = initial;
+  bool               haveModel = false;
+  double             model[2] = { 0.0, 0.0 };
+  itk::SizeValueType iterationsBefore = 0;
+  if (snapshot)
+  {
+    snapshot(initial, 0);
+  }
+  for (unsigned int stage = 0;; ++stage)
+  {
+    // Unlike the 3-D sphere, the initial circle is often already as fine as
+    // --edge-length (a small circle inside the object): the first level is
+    // then a capture level anyway, and a last level at the same resolution
+    // follows it.
+    bool last = regionWeight == 0.0;
+    auto deform = ContourFilterType::New();
+    deform->SetInput(ToMesh(stageInput));
+    deform->SetForceImage(result.force);
+    deform->SetScaleFactor(scale);
+    // As in 3-D: the capture level (the first of several) keeps the default
+    // internal weights, --elasticity and --rigidity shape the refined ones.
+    const bool capture = stage == 0 && !last;
+    deform->SetElasticity(capture ? defaults::Elasticity : o.elasticity);
+    deform->SetTangentialElasticity(o.tangentialElasticity);
+    deform->SetRigidity(capture ? defaults::Rigidity : o.rigidity);
+    deform->SetBalloon(o.balloon);
+    deform->SetIntensityImage(image);
+    // Refined levels finer than FineLevelEdgeLengths x --edge-length weight
+    // the region force by (h / that length)^2, as in 3-D: the membrane force
+    // of a contour of edge h bends it by about a h^2 kappa / 2 per iteration.
+    const double levelEdge = MeanEdgeLength(stageInput) / (defaults::FineLevelEdgeLengths * edgeLength);
+    deform->SetRegionWeight(stage == 0 ? regionWeight : regionWeight * std::min(1.0, levelEdge * levelEdge));
+    deform->SetRegionSigma(stage == 0 && !last ? defaults::CoarseRegionSigmaFactor * regionSigma : regionSigma);
+    deform->SetIntensityTolerance(o.intensityTolerance);
+    deform->SetEdgeSearchWeight(edgeSearchWeight);
+    deform->SetEdgeSearchDistance(edgeSearchDistance);
+    if (o.hasObjectRange)
+    {
+      deform->SetObjectIntensityRange(o.objectRange[0], o.objectRange[1], 0.1 * (o.objectRange[1] - o.objectRange[0]));
+    }
+    else if (haveModel)
+    {
+      deform->SetObjectIntensityStatistics(model[0], model[1]);
+    }
+    deform->SetFixedBoundary(o.fixedBoundary);
+    deform->SetMaximumStepLength(o.maximumStepLength);
+    deform->SetConvergenceTolerance(o.convergenceTolerance);
+    deform->SetConvergenceWindow(o.convergenceWindow);
+    deform->SetNumberOfIterations(o.iterations);
+    const std::string level = std::to_string(CountPoints(stageInput)) + " points";
+    progress.Start("deforming");
+    const auto deformStart = std::chrono::steady_clock::now();
+    deform->AddObserver(itk::ProgressEvent(), [&](const itk::EventObject &) {
+      const auto total = deform->GetNumberOfIterations();
+      const auto current = deform->GetCurrentIteration();
+      progress.Update(total > 0 ? static_cast<double>(current) / total : 1.0,
+                      level + ", iteration " + std::to_string(current) + "/" + std::to_string(total) +
+                        ", largest step " + Format(deform->GetLastMaximumDisplacement()) + " mm");
+    });
+    if (snapshot)
+    {
+      deform->AddObserver(itk::IterationEvent(), [&](const itk::EventObject &) {
+        if (deform->GetCurrentIteration() % o.snapshotEvery == 0)
+        {
+          snapshot(FromMesh(deform->GetOutput(), stageInput), iterationsBefore + deform->GetCurrentIteration());
+        }
+      });
+    }
+    try
+    {
+      deform->Update();
+    }
+    catch (const itk::ExceptionObject & exception)
+    {
+      throw Error("deformation: " + OneLine(exception.GetDescription()));
+    }
+    if (deform->GetRegionWeight() > 0.0 && !o.hasObjectRange && !haveModel)
+    {
+      haveModel = true;
+      model[0] = deform->GetObjectIntensityMedian();
+      model[1] = deform->GetObjectIntensitySpread();
+      progress.Note("region force: object intensity median " + Format(model[0], 4) + ", spread " + Format(model[1], 3) +
+                    " (estimated inside the initial contour)");
+    }
+    if (deform->GetRegionWeight() > 0.0)
+    {
+      progress.Note("region force: intensity range [" + Format(deform->GetObjectIntensityLower(), 4) + ", " +
+                    Format(deform->GetObjectIntensityUpper(), 4) + "], transition width " +
+                    Format(deform->GetObjectIntensityWidth(), 3));
+    }
+    const Contours output = FromMesh(deform->GetOutput(), stageInput);
+    if (snapshot && deform->GetCurrentIteration() % o.snapshotEvery != 0)
+    {
+      snapshot(output, iterationsBefore + deform->GetCurrentIteration());
+    }
+    result.iterations += deform->GetCurrentIteration();
+    iterationsBefore = result.iterations;
+    result.converged = deform->GetConverged();
+    result.lastMaximumDisplacement = deform->GetLastMaximumDisplacement();
+    const double deformSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - deformStart).count();
+    progress.Finish(std::to_string(deform->GetCurrentIteration()) + " iterations on " + level + ", " +
+                    (result.converged ? "converged (largest step below " + Format(o.convergenceTolerance) + " mm for " +
+                                          std::to_string(o.convergenceWindow) + " iterations)"
+                                      : std::string("iteration cap reached")) +
+                    ", last largest step " + Format(result.lastMaximumDisplacement) + " mm (" +
+                    Format(deformSeconds, 2) + " s)");
+    const bool fine = !(MeanEdgeLength(output) > 1.5 * edgeLength) ||
+                      2 * CountPoints(output) > defaults::MaximumRefinedPoints;
+    if (last || (stage > 0 && fine))
+    {
+      result.contours = output;
+      break;
+    }
+    stageInput = fine ? output : Subdivide(output);
+  }
+  return result;
+}
+
+/** A contour that left the image or collapsed is a failed run (exit 1):
+ * nothing is written. Points within one pixel beyond the image's edge are an
+ * object cut by it, not a contour that left. */
+void
+CheckFinalContours(const Image2DType * image, const Contours & initial, const Contours & final)
+{
+  size_t outside = 0;
+  for (const auto & c : final)
+  {
+    for (const auto & p : c.points)
+    {
+      outside += IsInsideImage(image, p, 1.0) ? 0 : 1;
+    }
+  }
+  if (outside > 0)
+  {
+    throw Error("the contour left the image: " + std::to_string(outside) + " of " +
+                  std::to_string(CountPoints(final)) +
+                  " points lie more than a pixel outside it (a balloon or region force too strong for the image's "
+                  "edges?); nothing written",
+                ExitFailure);
+  }
+  for (size_t k = 0; k < final.size(); ++k)
+  {
+    const bool   closed = final[k].closed;
+    const double before = closed ? Area(initial[k]) : Length(initial[k]);
+    const double after = closed ? Area(final[k]) : Length(final[k]);
+    if (before > 0.0 && !(after >= 1e-3 * before))
+    {
+      throw Error("the contour collapsed: it " + (closed ? "encloses " + Format(after) + " mm^2" : "is " + Format(after) + " mm long") +
+                    ", " + Format(100.0 * after / before) + " % of the initial " + Format(before) +
+                    (closed ? " mm^2" : " mm") + "; nothing written",
+                  ExitFailure);
+    }
+  }
+}
+
+std::string
+DescribeContours(const Contours & contours)
+{
+  size_t closed = 0;
+  for (const auto & c : contours)
+  {
+    closed += c.closed ? 1 : 0;
+  }
+  std::string text = std::to_string(CountPoints(contours)) + " points, ";
+  if (contours.size() == 1)
+  {
+    text += closed == 1 ? "closed" : "open";
+  }
+  else
+  {
+    text += std::to_string(contours.size()) + " contours (" + std::to_string(closed) + " closed)";
+  }
+  return text;
+}
+
+} // namespace
+
+int
+RunSegmentContour(const SegmentOptions & o, const GlobalOptions & global)
+{
+  // Every output is checked before the computation starts.
+  CheckContourOutputPath(o.output, "--output");
+  if (!o.forceOutput.empty())
+  {
+    CheckImageOutputPath(o.forceOutput, "--force-output");
+  }
+  if (!o.overlayPng.empty())
+  {
+    if (GetExtension(o.overlayPng) != ".png")
+    {
+      throw Error("--overlay-png: " + Quote(o.overlayPng) + " must end in .png");
+    }
+    CheckOutputDirectoryOf(o.overlayPng, "--overlay-png");
+  }
+  if (o.preventSelfIntersections)
+  {
+    throw Error("--prevent-self-intersections works on the triangles of surfaces, not on 2-D contours");
+  }
+  if (!o.snapshots.empty())
+  {
+    if (!HasVTK())
+    {
+      throw Error("--snapshots: the .pvd time series needs VTK, and this edmodel was built without VTK");
+    }
+    std::error_code error;
+    if (fs::exists(o.snapshots, error) && !fs::is_directory(o.snapshots, error))
+    {
+      throw Error("--snapshots: '" + o.snapshots + "' is not a directory");
+    }
+    const fs::path directory(o.snapshots);
+    const fs::path parent = directory.has_parent_path() ? directory.parent_path() : fs::path(".");
+    if (!fs::is_directory(parent, error))
+    {
+      throw Error("--snapshots: directory '" + parent.string() + "' does not exist");
+    }
+  }
+
+  Progress                   progress(global.quiet);
+  const Image2DType::Pointer image = ReadImage2D(o.image, o.gradientVectorFlow);
+  Contours                   initial;
+  if (!o.initContour.empty())
+  {
+    initial = ReadInitialContours(o);
+    CheckInitialContours(image, initial, o.initContour, progress);
+  }
+  else
+  {
+    initial = MakeInitialCircle(image, o);
+  }
+  if (HasOpenContour(initial))
+  {
+    if (o.regionWeight > 0.0)
+    {
+      throw Error("--region: the region force needs closed contours (outward is undefined on an open contour)");
+    }
+    if (o.balloon != 0.0)
+    {
+      throw Error("--balloon: the balloon needs closed contours (outward is undefined on an open contour)");
+    }
+    if (o.edgeSearchWeight > 0.0)
+    {
+      throw Error("--edge-search: the edge search needs closed contours (outward is undefined on an open contour)");
+    }
+  }
+  const auto size = image->GetLargestPossibleRegion().GetSize();
+  progress.Note("2-D image " + std::to_string(size[0]) + " x " + std::to_string(size[1]) + ", spacing " +
+                Format(image->GetSpacing()[0]) + " x " + Format(image->GetSpacing()[1]) + " mm; initial contour " +
+                DescribeContours(initial));
+
+  std::unique_ptr<SnapshotSeries> series;
+  ContourSnapshot                 snapshot;
+#ifdef EDM_HAVE_VTK
+  if (!o.snapshots.empty())
+  {
+    series = std::make_unique<SnapshotSeries>(o.snapshots, fs::path(o.output).stem().string());
+    snapshot = [&series](const Contours & contours, itk::SizeValueType iteration) {
+      series->Add(ToSurfaceMesh(contours), iteration);
+    };
+  }
+#endif
+
+  const ContourResult result = DeformContours(image, initial, o, progress, snapshot);
+  // Levels refine the contours: compare with the initial ones contour by
+  // contour (the same layout).
+  CheckFinalContours(image, initial, result.contours);
+
+  if (!o.forceOutput.empty())
+  {
+    WriteImage(result.force.GetPointer(), o.forceOutput);
+  }
+  if (!o.overlayPng.empty())
+  {
+    WriteOverlay(image, initial, result.contours, o.overlayPng);
+  }
+  WriteContours(result.contours, o.output);
+  if (series)
+  {
+    series->Commit();
+    progress.Note("wrote " + std::to_string(series->GetNumberOfFiles()) + " snapshots, every " +
+                  std::to_string(o.snapshotEvery) + " iterations: " + series->GetCollectionPath());
+  }
+  if (!global.quiet)
+  {
+    std::cout << "edmodel: wrote " << o.output << " (" << DescribeContours(result.contours) << ") after "
+              << result.iterations << " iterations" << (result.converged ? ", converged" : ", not converged")
+              << (o.overlayPng.empty() ? std::string() : "; overlay " + o.overlayPng) << std::endl;
+  }
+  return ExitSuccess;
+}
+
+} // namespace edm
