@@ -1046,7 +1046,8 @@ DeformContours(const Image2DType *     image,
     // internal weights, --elasticity and --rigidity shape the refined ones.
     const bool capture = stage == 0 && !last;
     deform->SetElasticity(capture ? defaults::Elasticity : o.elasticity);
-    deform->SetTangentialElasticity(o.tangentialElasticity);
+    deform->SetTangentialElasticity(o.tangentialElasticityGiven ? o.tangentialElasticity
+                                                                : defaults::ContourTangentialElasticity);
     deform->SetRigidity(capture ? defaults::Rigidity : o.rigidity);
     deform->SetBalloon(o.balloon);
     deform->SetIntensityImage(image);

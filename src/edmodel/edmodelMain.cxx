@@ -378,15 +378,24 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                 "",
                 "keep only the component of the elastic force tangent to the surface (it then spaces the vertices "
                 "evenly but no longer smooths the surface's shape)",
-                defaults::TangentialElasticity ? "tangential" : "full umbrella (smooths the shape)",
-                [&o](const std::string &) { o.tangentialElasticity = true; } });
+                std::string(defaults::TangentialElasticity ? "tangential" : "full umbrella (smooths the shape)") +
+                  " on 3-D surfaces, " + (defaults::ContourTangentialElasticity ? "tangential" : "full umbrella") +
+                  " on 2-D contours",
+                [&o](const std::string &) {
+                  o.tangentialElasticity = true;
+                  o.tangentialElasticityGiven = true;
+                } });
   t.push_back({ model,
                 "--no-tangential-elasticity",
                 "",
                 "use the full umbrella operator (Laplacian smoothing: smooths the surface and keeps it from folding; "
                 "shrinks convex surfaces slightly, which the region force balances)",
-                defaults::TangentialElasticity ? "tangential" : "full umbrella",
-                [&o](const std::string &) { o.tangentialElasticity = false; } });
+                std::string(defaults::TangentialElasticity ? "tangential" : "full umbrella") + " on 3-D surfaces, " +
+                  (defaults::ContourTangentialElasticity ? "tangential" : "full umbrella") + " on 2-D contours",
+                [&o](const std::string &) {
+                  o.tangentialElasticity = false;
+                  o.tangentialElasticityGiven = true;
+                } });
   t.push_back({ model,
                 "--rigidity",
                 "B",

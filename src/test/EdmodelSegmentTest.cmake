@@ -10,6 +10,10 @@
 # CONVERT: optional edmodel arguments run after the segmentation that turn
 # OUTPUT into MEASURED (a format the measuring tool reads), then measured.
 # PRESENT: optional files that must exist afterwards.
+# MEASURE_COMMAND: the edmodelTestTool command that measures (default
+# measure: a mesh against an ellipsoid; measure-contour: a 2-D contour
+# against an ellipse; check-ends: the ends of an open contour). CHECK: optional edmodelTestTool arguments of a further
+# check that must succeed (e.g. check-overlay).
 # REQUIRES_VTK: skip (message "test skipped") when edmodel is built without VTK.
 cmake_minimum_required(VERSION 3.16)
 include(${CMAKE_CURRENT_LIST_DIR}/EdmodelTestCommon.cmake)
@@ -59,9 +63,16 @@ if(CONVERT)
   edm_expand(output "${MEASURED}")
 endif()
 
+if(CHECK)
+  edm_run_helper("${TOOL}|${CHECK}")
+endif()
+
+if(NOT MEASURE_COMMAND)
+  set(MEASURE_COMMAND measure)
+endif()
 edm_expand(measure "${MEASURE}")
-execute_process(COMMAND ${TOOL} measure ${output} ${measure} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+execute_process(COMMAND ${TOOL} ${MEASURE_COMMAND} ${output} ${measure} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 message(STATUS "${out}${err}")
 if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "the output mesh is not on the ellipsoid")
+  message(FATAL_ERROR "the output is not on the known boundary")
 endif()

@@ -15,6 +15,8 @@
 //                   (anti-aliased 2-D ellipse, the a-axis at RAD from x; --slab: a volume of one slice)
 //   edmodelTestTool measure-contour CONTOUR(.csv|.vtk) --center X,Y --radii A,B [--angle RAD]
 //                   --max-mean D --max-max D [--min-points N]
+//   edmodelTestTool contour-csv CSV --points X1,Y1,X2,Y2,...   (one contour, x,y per line)
+//   edmodelTestTool check-ends CONTOUR(.csv|.vtk) --first X,Y --last X,Y   (exactly these ends)
 //   edmodelTestTool check-overlay PNG --min-size N --min-red N
 //                   (an RGB PNG at least N pixels across, with at least N red contour pixels)
 //   edmodelTestTool measure MESH --center X,Y,Z --radii A,B,C [--axes 9 numbers]
@@ -37,6 +39,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <algorithm>
 #include <array>
 #include <filesystem>
 #include <fstream>
@@ -556,6 +559,31 @@ main(int argc, char * argv[])
     if (command == "measure-contour")
     {
       return MeasureContour(path, options);
+    }
+    if (command == "contour-csv")
+    {
+      const auto  text = options.at("--points");
+      const auto  count = static_cast<size_t>(std::count(text.begin(), text.end(), ',') + 1);
+      const auto  values = Numbers(options, "--points", count);
+      std::ofstream stream(path);
+      stream << "x,y\n";
+      for (size_t k = 0; k + 1 < values.size(); k += 2)
+      {
+        stream << values[k] << "," << values[k + 1] << "\n";
+      }
+      return stream ? EXIT_SUCCESS : EXIT_FAILURE;
+    }
+    if (command == "check-ends")
+    {
+      const auto points = ReadContourPoints(path);
+      const auto first = Numbers(options, "--first", 2);
+      const auto last = Numbers(options, "--last", 2);
+      std::cout << path << ": " << points.size() << " points from (" << points.front()[0] << ", " << points.front()[1]
+                << ") to (" << points.back()[0] << ", " << points.back()[1] << ")" << std::endl;
+      return points.size() > 2 && points.front()[0] == first[0] && points.front()[1] == first[1] &&
+                 points.back()[0] == last[0] && points.back()[1] == last[1]
+               ? EXIT_SUCCESS
+               : EXIT_FAILURE;
     }
     if (command == "check-overlay")
     {
