@@ -1209,6 +1209,12 @@ RunSegmentContour(const SegmentOptions & o, const GlobalOptions & global)
   if (!o.forceOutput.empty())
   {
     CheckImageOutputPath(o.forceOutput, "--force-output");
+    const std::string extension = GetExtension(o.forceOutput);
+    if (extension == ".nii" || extension == ".nii.gz")
+    {
+      throw Error("--force-output: ITK's NIfTI writer cannot hold the force field of a 2-D image (2 components "
+                  "per pixel): use .mha, .mhd, .nrrd or .nhdr");
+    }
   }
   if (!o.overlayPng.empty())
   {

@@ -2474,25 +2474,8 @@ WriteImage(const Image2DType * image, const std::string & path)
 void
 WriteImage(const Force2DType * image, const std::string & path)
 {
-  const std::string extension = GetExtension(path);
-  if (extension == ".nii" || extension == ".nii.gz")
-  {
-    using VectorImageType = itk::Image<itk::Vector<float, 2>, 2>;
-    auto vectors = VectorImageType::New();
-    vectors->CopyInformation(image);
-    vectors->SetRegions(image->GetBufferedRegion());
-    vectors->Allocate();
-    const auto *             in = image->GetBufferPointer();
-    auto *                   out = vectors->GetBufferPointer();
-    const itk::SizeValueType n = image->GetBufferedRegion().GetNumberOfPixels();
-    for (itk::SizeValueType i = 0; i < n; ++i)
-    {
-      out[i][0] = in[i][0];
-      out[i][1] = in[i][1];
-    }
-    WriteAnyImage(vectors.GetPointer(), path);
-    return;
-  }
+  // ITK 5.2's NIfTI writer refuses this field (RunSegmentContour says so
+  // before computing).
   WriteAnyImage(image, path);
 }
 

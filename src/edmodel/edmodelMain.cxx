@@ -265,7 +265,8 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
   t.push_back({ io,
                 "--force-output",
                 "IMG",
-                "also write the external force field (3-component vector image, e.g. .mha, .nrrd, .nii.gz)",
+                "also write the external force field (vector image of 3 components, 2 for a 2-D image, e.g. .mha, "
+                ".nrrd, .nii.gz)",
                 "",
                 [&o](const std::string & s) { o.forceOutput = s; } });
   t.push_back({ io,
@@ -657,10 +658,11 @@ PrintSegmentHelp(std::ostream & os, const OptionTable & table)
         "2-D images (a 2-D file, or a volume of one slice): the model is a contour (a snake), started from\n"
         "--init-circle X,Y,R or --init-contour FILE instead of a sphere or a mesh, with the same filters,\n"
         "options and defaults (a circle of --circle-points points refined to --edge-length; the region\n"
-        "force estimated inside the initial circle). --output .vtk/.vtp/.csv writes the contour, and\n"
-        "--overlay-png draws it over the image. An open contour (--open, or an open polyline) has no\n"
-        "region force or balloon; --fixed-boundary keeps its ends. --init-sphere and --init-mesh need a\n"
-        "3-D image, --init-circle and --init-contour a 2-D one.\n"
+        "force estimated inside the initial circle), except the elasticity, tangential on contours.\n"
+        "--output .vtk/.vtp/.csv writes the contour, --overlay-png draws it over the image. An open\n"
+        "contour (--open, or an open polyline) has no region force or balloon; --fixed-boundary keeps\n"
+        "its ends. --init-sphere and --init-mesh need a 3-D image, --init-circle and --init-contour a\n"
+        "2-D one.\n"
         "  edmodel segment --image cells.png --init-circle 120,80,15 --output cell.csv --overlay-png cell.png\n";
   PrintOptions(os, table);
 }
