@@ -1023,7 +1023,14 @@ DeformContours(const Image2DType *     image,
     progress.Note("open contour: no region force (outward is undefined); gradient forces only");
   }
 
-  Contours           stageInput = initial;
+  // A contour inside the image is at most a few times the image's
+  // perimeter long: refining beyond 4 times that many edges of
+  // --edge-length means it has left the image or tangled (checked after the
+  // run); the levels stop there.
+  const auto   imageSize = image->GetLargestPossibleRegion().GetSize();
+  const double perimeter = 2.0 * (imageSize[0] * image->GetSpacing()[0] + imageSize[1] * image->GetSpacing()[1]);
+  const double maximumPoints = std::min<double>(defaults::MaximumRefinedPoints, 4.0 * perimeter / edgeLength);
+  Contours     stageInput = initial;
   bool               haveModel = false;
   double             model[2] = { 0.0, 0.0 };
   itk::SizeValueType iterationsBefore = 0;
@@ -1130,8 +1137,8 @@ DeformContours(const Image2DType *     image,
                                       : std::string("iteration cap reached")) +
                     ", last largest step " + Format(result.lastMaximumDisplacement) + " mm (" +
                     Format(deformSeconds, 2) + " s)");
-    const bool fine = !(MeanEdgeLength(output) > 1.5 * edgeLength) ||
-                      2 * CountPoints(output) > defaults::MaximumRefinedPoints;
+    const bool fine =
+      !(MeanEdgeLength(output) > 1.5 * edgeLength) || 2.0 * static_cast<double>(CountPoints(output)) > maximumPoints;
     if (last || (stage > 0 && fine))
     {
       result.contours = output;
