@@ -510,7 +510,7 @@ ContoursFromMesh(const MeshType * mesh, const std::string & path)
   std::set<itk::IdentifierType> visited;
   Contours                      contours;
   const auto                    follow = [&](itk::IdentifierType start, bool closed) {
-    Contour             c;
+    Contour c;
     c.closed = closed;
     itk::IdentifierType previous = start;
     itk::IdentifierType current = start;
@@ -632,7 +632,10 @@ MakeInitialCircle(const Image2DType * image, const SegmentOptions & o)
 }
 
 void
-CheckInitialContours(const Image2DType * image, const Contours & contours, const std::string & path, Progress & progress)
+CheckInitialContours(const Image2DType * image,
+                     const Contours &    contours,
+                     const std::string & path,
+                     Progress &          progress)
 {
   size_t outside = 0;
   for (const auto & c : contours)
@@ -840,14 +843,15 @@ WriteOverlay(const Image2DType * image, const Contours & initial, const Contours
   // Width and height in pixels of the smallest spacing, then enlarged.
   const double width = size[0] * image->GetSpacing()[0] / smallest;
   const double height = size[1] * image->GetSpacing()[1] / smallest;
-  const double zoom = std::max(1.0, std::min(std::ceil(512.0 / std::max(width, height)), 4096.0 / std::max(width, height)));
+  const double zoom =
+    std::max(1.0, std::min(std::ceil(512.0 / std::max(width, height)), 4096.0 / std::max(width, height)));
   RGBImageType::SizeType outputSize;
   outputSize[0] = std::max<itk::SizeValueType>(1, static_cast<itk::SizeValueType>(std::lround(width * zoom)));
   outputSize[1] = std::max<itk::SizeValueType>(1, static_cast<itk::SizeValueType>(std::lround(height * zoom)));
 
-  std::vector<float>       values(image->GetBufferPointer(),
+  std::vector<float> values(image->GetBufferPointer(),
                             image->GetBufferPointer() + image->GetBufferedRegion().GetNumberOfPixels());
-  const auto               percentile = [&values](double q) {
+  const auto         percentile = [&values](double q) {
     const size_t k = static_cast<size_t>(q * static_cast<double>(values.size() - 1));
     std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
     return static_cast<double>(values[k]);
@@ -871,11 +875,13 @@ WriteOverlay(const Image2DType * image, const Contours & initial, const Contours
     for (itk::SizeValueType u = 0; u < outputSize[0]; ++u)
     {
       Image2DType::IndexType index;
-      index[0] = start[0] + std::min<itk::IndexValueType>(size[0] - 1, static_cast<itk::IndexValueType>((u + 0.5) / scaleX));
-      index[1] = start[1] + std::min<itk::IndexValueType>(size[1] - 1, static_cast<itk::IndexValueType>((v + 0.5) / scaleY));
-      const double  t = std::min(1.0, std::max(0.0, (image->GetPixel(index) - low) / range));
-      const auto    grey = static_cast<unsigned char>(std::lround(255.0 * t));
-      RGBPixelType  pixel;
+      index[0] =
+        start[0] + std::min<itk::IndexValueType>(size[0] - 1, static_cast<itk::IndexValueType>((u + 0.5) / scaleX));
+      index[1] =
+        start[1] + std::min<itk::IndexValueType>(size[1] - 1, static_cast<itk::IndexValueType>((v + 0.5) / scaleY));
+      const double t = std::min(1.0, std::max(0.0, (image->GetPixel(index) - low) / range));
+      const auto   grey = static_cast<unsigned char>(std::lround(255.0 * t));
+      RGBPixelType pixel;
       pixel.Set(grey, grey, grey);
       RGBImageType::IndexType out = { { static_cast<itk::IndexValueType>(u), static_cast<itk::IndexValueType>(v) } };
       overlay->SetPixel(out, pixel);
@@ -952,11 +958,11 @@ WriteOverlay(const Image2DType * image, const Contours & initial, const Contours
 
 struct ContourResult
 {
-  Contours                contours;
-  Force2DType::Pointer    force;
-  itk::SizeValueType      iterations{ 0 };
-  bool                    converged{ false };
-  double                  lastMaximumDisplacement{ 0.0 };
+  Contours             contours;
+  Force2DType::Pointer force;
+  itk::SizeValueType   iterations{ 0 };
+  bool                 converged{ false };
+  double               lastMaximumDisplacement{ 0.0 };
 };
 
 using ContourSnapshot = std::function<void(const Contours &, itk::SizeValueType)>;
@@ -1010,11 +1016,13 @@ DeformContours(const Image2DType *     image,
 
   // Outward is undefined on an open contour: no region force there.
   const bool   open = HasOpenContour(initial);
-  const double regionWeight =
-    open ? 0.0 : o.regionWeight >= 0.0 ? o.regionWeight : defaults::RegionWeightInVoxels * smallest;
+  const double regionWeight = open                    ? 0.0
+                              : o.regionWeight >= 0.0 ? o.regionWeight
+                                                      : defaults::RegionWeightInVoxels * smallest;
   const double regionSigma = o.regionSigma >= 0.0 ? o.regionSigma : defaults::RegionSigmaInVoxels * smallest;
-  const double edgeSearchWeight =
-    open ? 0.0 : o.edgeSearchWeight >= 0.0 ? o.edgeSearchWeight : defaults::EdgeSearchWeightInVoxels * smallest;
+  const double edgeSearchWeight = open                        ? 0.0
+                                  : o.edgeSearchWeight >= 0.0 ? o.edgeSearchWeight
+                                                              : defaults::EdgeSearchWeightInVoxels * smallest;
   const double edgeSearchDistance =
     o.edgeSearchDistance > 0.0 ? o.edgeSearchDistance : defaults::EdgeSearchDistanceInVoxels * smallest;
   const double edgeLength = o.edgeLength > 0.0 ? o.edgeLength : defaults::EdgeLengthInVoxels * smallest;
@@ -1027,10 +1035,10 @@ DeformContours(const Image2DType *     image,
   // perimeter long: refining beyond 4 times that many edges of
   // --edge-length means it has left the image or tangled (checked after the
   // run); the levels stop there.
-  const auto   imageSize = image->GetLargestPossibleRegion().GetSize();
-  const double perimeter = 2.0 * (imageSize[0] * image->GetSpacing()[0] + imageSize[1] * image->GetSpacing()[1]);
-  const double maximumPoints = std::min<double>(defaults::MaximumRefinedPoints, 4.0 * perimeter / edgeLength);
-  Contours     stageInput = initial;
+  const auto         imageSize = image->GetLargestPossibleRegion().GetSize();
+  const double       perimeter = 2.0 * (imageSize[0] * image->GetSpacing()[0] + imageSize[1] * image->GetSpacing()[1]);
+  const double       maximumPoints = std::min<double>(defaults::MaximumRefinedPoints, 4.0 * perimeter / edgeLength);
+  Contours           stageInput = initial;
   bool               haveModel = false;
   double             model[2] = { 0.0, 0.0 };
   itk::SizeValueType iterationsBefore = 0;
@@ -1165,8 +1173,7 @@ CheckFinalContours(const Image2DType * image, const Contours & initial, const Co
   }
   if (outside > 0)
   {
-    throw Error("the contour left the image: " + std::to_string(outside) + " of " +
-                  std::to_string(CountPoints(final)) +
+    throw Error("the contour left the image: " + std::to_string(outside) + " of " + std::to_string(CountPoints(final)) +
                   " points lie more than a pixel outside it (a balloon or region force too strong for the image's "
                   "edges?); nothing written",
                 ExitFailure);
@@ -1178,8 +1185,9 @@ CheckFinalContours(const Image2DType * image, const Contours & initial, const Co
     const double after = closed ? Area(final[k]) : Length(final[k]);
     if (before > 0.0 && !(after >= 1e-3 * before))
     {
-      throw Error("the contour collapsed: it " + (closed ? "encloses " + Format(after) + " mm^2" : "is " + Format(after) + " mm long") +
-                    ", " + Format(100.0 * after / before) + " % of the initial " + Format(before) +
+      throw Error("the contour collapsed: it " +
+                    (closed ? "encloses " + Format(after) + " mm^2" : "is " + Format(after) + " mm long") + ", " +
+                    Format(100.0 * after / before) + " % of the initial " + Format(before) +
                     (closed ? " mm^2" : " mm") + "; nothing written",
                   ExitFailure);
     }

@@ -2023,11 +2023,10 @@ ReadImagePixels(const std::string & path, itk::ImageIOBase * io, bool gradientVe
   CheckImageGeometry(path, io);
   // The file's pixels, the float image, the force filter's float images and
   // field (and the diffusion's arrays with gradient vector flow).
-  const double filePixel = static_cast<double>(io->GetComponentSize() * io->GetNumberOfComponents());
+  const double     filePixel = static_cast<double>(io->GetComponentSize() * io->GetNumberOfComponents());
   constexpr double dimension = TImage::ImageDimension;
-  CheckMemoryForImage(path,
-                      ImageSize(io),
-                      filePixel + 4.0 + (40.0 + (gradientVectorFlow ? 40.0 : 0.0)) * dimension / 3.0);
+  CheckMemoryForImage(
+    path, ImageSize(io), filePixel + 4.0 + (40.0 + (gradientVectorFlow ? 40.0 : 0.0)) * dimension / 3.0);
   CheckImageData(path, io);
 
   typename TImage::Pointer image;

@@ -202,25 +202,25 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                 "--init-sphere",
                 "",
                 [&o](const std::string & s) { o.initMesh = s; } });
-  t.push_back({ io,
-                "--init-circle",
-                "X,Y,R",
-                "2-D image: initial contour, a circle of centre (X,Y) and radius R in physical coordinates (mm), "
-                "inside the object; it must lie inside the image",
-                "centred in the image, radius " + FormatNumber(defaults::SphereRadiusOverExtent) +
-                  " x the smallest extent",
-                [&o](const std::string & s) {
-                  const auto v = ParseList("--init-circle", s, 3, "X,Y,R");
-                  for (unsigned int k = 0; k < 3; ++k)
-                  {
-                    o.circle[k] = v[k];
-                  }
-                  if (!(v[2] > 0.0))
-                  {
-                    throw Error("--init-circle: the radius must be positive, got " + FormatNumber(v[2]));
-                  }
-                  o.hasInitCircle = true;
-                } });
+  t.push_back(
+    { io,
+      "--init-circle",
+      "X,Y,R",
+      "2-D image: initial contour, a circle of centre (X,Y) and radius R in physical coordinates (mm), "
+      "inside the object; it must lie inside the image",
+      "centred in the image, radius " + FormatNumber(defaults::SphereRadiusOverExtent) + " x the smallest extent",
+      [&o](const std::string & s) {
+        const auto v = ParseList("--init-circle", s, 3, "X,Y,R");
+        for (unsigned int k = 0; k < 3; ++k)
+        {
+          o.circle[k] = v[k];
+        }
+        if (!(v[2] > 0.0))
+        {
+          throw Error("--init-circle: the radius must be positive, got " + FormatNumber(v[2]));
+        }
+        o.hasInitCircle = true;
+      } });
   t.push_back({ io,
                 "--circle-points",
                 "N",
@@ -874,8 +874,8 @@ Main(const std::vector<std::string> & args)
     }
     if (dimension != 2 && contour)
     {
-      throw Error(std::string(options.hasInitCircle ? "--init-circle" : "--init-contour") + " needs a 2-D image: " +
-                  image + " is " + std::to_string(dimension) + "-D" +
+      throw Error(std::string(options.hasInitCircle ? "--init-circle" : "--init-contour") +
+                  " needs a 2-D image: " + image + " is " + std::to_string(dimension) + "-D" +
                   (description.empty() ? std::string() : " (" + description + ")") +
                   "; use --init-sphere X,Y,Z,R or --init-mesh FILE");
     }

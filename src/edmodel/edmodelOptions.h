@@ -60,14 +60,14 @@ constexpr double Elasticity = 0.3;
 /** The full umbrella operator (not only its tangential part, the core's
  * default): with the region force, the normal part is what keeps the
  * surface from folding into dark pockets (ventricles, sulci). */
-constexpr bool         TangentialElasticity = false;
+constexpr bool TangentialElasticity = false;
 /** On 2-D contours, the tangential part only (the core's default): along a
  * chain of points the umbrella operator damps the mode of points alternating
  * across the curve by 2a per iteration (about 1.5a on a triangle mesh), and
  * with the image and region forces the step overshoots: from the full
  * umbrella, the capture level oscillated without converging on every
  * synthetic shape of bench/compare-skimage.py. Rigidity still smooths. */
-constexpr bool ContourTangentialElasticity = true;
+constexpr bool         ContourTangentialElasticity = true;
 constexpr double       Rigidity = 0.05;
 constexpr unsigned int Iterations = 500;
 constexpr double       ConvergenceTolerance = 0.02;

@@ -308,14 +308,14 @@ void
 WriteEllipse2D(const std::string & path, const std::map<std::string, std::string> & options)
 {
   using ImageType = itk::Image<TPixel, VDimension>;
-  const auto   size = Numbers(options, "--size", 2);
-  const auto   spacing = Numbers(options, "--spacing", 2);
-  const auto   origin = Numbers(options, "--origin", 2);
-  const auto   c = Numbers(options, "--center", 2);
-  const auto   r = Numbers(options, "--radii", 2);
-  const double angle = options.count("--angle") ? std::stod(options.at("--angle")) : 0.0;
-  const double inside = options.count("--inside") ? std::stod(options.at("--inside")) : 200.0;
-  const double outside = options.count("--outside") ? std::stod(options.at("--outside")) : 40.0;
+  const auto                      size = Numbers(options, "--size", 2);
+  const auto                      spacing = Numbers(options, "--spacing", 2);
+  const auto                      origin = Numbers(options, "--origin", 2);
+  const auto                      c = Numbers(options, "--center", 2);
+  const auto                      r = Numbers(options, "--radii", 2);
+  const double                    angle = options.count("--angle") ? std::stod(options.at("--angle")) : 0.0;
+  const double                    inside = options.count("--inside") ? std::stod(options.at("--inside")) : 200.0;
+  const double                    outside = options.count("--outside") ? std::stod(options.at("--outside")) : 40.0;
   typename ImageType::SizeType    imageSize;
   typename ImageType::SpacingType imageSpacing;
   typename ImageType::PointType   imageOrigin;
@@ -562,9 +562,9 @@ main(int argc, char * argv[])
     }
     if (command == "contour-csv")
     {
-      const auto  text = options.at("--points");
-      const auto  count = static_cast<size_t>(std::count(text.begin(), text.end(), ',') + 1);
-      const auto  values = Numbers(options, "--points", count);
+      const auto    text = options.at("--points");
+      const auto    count = static_cast<size_t>(std::count(text.begin(), text.end(), ',') + 1);
+      const auto    values = Numbers(options, "--points", count);
       std::ofstream stream(path);
       stream << "x,y\n";
       for (size_t k = 0; k + 1 < values.size(); k += 2)
