@@ -584,11 +584,18 @@ Deform(const ImageType *        image,
     {
       deform->SetObjectIntensityStatistics(model[0], model[1]);
     }
+    deform->SetDampOscillations(o.dampOscillations);
     deform->SetPreventSelfIntersections(o.preventSelfIntersections);
     deform->SetMinimumDistance(o.minimumDistance);
     deform->SetMaximumStepLength(o.maximumStepLength);
-    deform->SetConvergenceTolerance(o.convergenceTolerance);
+    // --tolerance is the finest level's; a coarser level, whose position
+    // only needs to be known to a fraction of its own edge length before it
+    // is refined, converges at the tolerance scaled by its mean edge over
+    // --edge-length.
+    deform->SetConvergenceTolerance(o.convergenceTolerance *
+                                    (last ? 1.0 : std::max(1.0, MeanEdgeLength(stageInput) / edgeLength)));
     deform->SetConvergenceWindow(o.convergenceWindow);
+    deform->SetConvergenceFraction(o.convergenceFraction);
     deform->SetNumberOfIterations(o.iterations);
     const std::string level = std::to_string(stageInput->GetNumberOfPoints()) + " points";
     progress.Start("deforming");
@@ -641,9 +648,17 @@ Deform(const ImageType *        image,
     result.lastMaximumDisplacement = deform->GetLastMaximumDisplacement();
     const double deformSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - deformStart).count();
     progress.Finish(std::to_string(deform->GetCurrentIteration()) + " iterations on " + level + ", " +
-                    (result.converged ? "converged (largest step below " + Format(o.convergenceTolerance) + " mm for " +
-                                          std::to_string(o.convergenceWindow) + " iterations)"
-                                      : std::string("iteration cap reached")) +
+                    (result.converged
+                       ? "converged (" +
+                           (o.convergenceFraction > 0.0
+                              ? "at most " +
+                                  std::to_string(static_cast<unsigned long long>(
+                                    o.convergenceFraction * static_cast<double>(stageInput->GetNumberOfPoints()))) +
+                                  " vertices moving by "
+                              : std::string("largest step below ")) +
+                           Format(deform->GetConvergenceTolerance()) + " mm for " +
+                           std::to_string(o.convergenceWindow) + " iterations)"
+                       : std::string("iteration cap reached")) +
                     ", last largest step " + Format(result.lastMaximumDisplacement) + " mm (" +
                     Format(deformSeconds, 2) + " s)");
     MeshType::Pointer output = deform->GetOutput();
