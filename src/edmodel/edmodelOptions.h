@@ -63,6 +63,9 @@ constexpr double Elasticity = 0.3;
 constexpr bool         TangentialElasticity = false;
 constexpr double       Rigidity = 0.05;
 constexpr unsigned int Iterations = 500;
+/** Iteration cap of the capture level (the first of several coarse-to-fine
+ * levels) when --iterations is lower. */
+constexpr unsigned int CaptureIterations = 2000;
 constexpr double       ConvergenceTolerance = 0.02;
 /** A level is quiet when at most this fraction of its vertices move by the
  * tolerance or more (the filter's ConvergenceFraction). */

@@ -588,15 +588,16 @@ Deform(const ImageType *        image,
     deform->SetPreventSelfIntersections(o.preventSelfIntersections);
     deform->SetMinimumDistance(o.minimumDistance);
     deform->SetMaximumStepLength(o.maximumStepLength);
-    // --tolerance is the finest level's; a coarser level, whose position
-    // only needs to be known to a fraction of its own edge length before it
-    // is refined, converges at the tolerance scaled by its mean edge over
-    // --edge-length.
-    deform->SetConvergenceTolerance(o.convergenceTolerance *
-                                    (last ? 1.0 : std::max(1.0, MeanEdgeLength(stageInput) / edgeLength)));
+    deform->SetConvergenceTolerance(o.convergenceTolerance);
     deform->SetConvergenceWindow(o.convergenceWindow);
     deform->SetConvergenceFraction(o.convergenceFraction);
-    deform->SetNumberOfIterations(o.iterations);
+    // The capture level runs until it converges, up to CaptureIterations
+    // (or --iterations when larger): from a small sphere it travels far, and
+    // its front slows down as it fills narrow lobes (ch2: 700 iterations),
+    // so that a cap of 500 would stop it anywhere along the way and the
+    // result would depend on --iterations.
+    deform->SetNumberOfIterations(capture && o.iterations > 0 ? std::max(o.iterations, defaults::CaptureIterations)
+                                                              : o.iterations);
     const std::string level = std::to_string(stageInput->GetNumberOfPoints()) + " points";
     progress.Start("deforming");
     const auto deformStart = std::chrono::steady_clock::now();
