@@ -27,6 +27,7 @@
 #include "itkForceImageCheck.h"
 #include "itkSurfaceCollision.h"
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -97,6 +98,20 @@ namespace itk
  * ConvergenceWindow consecutive iterations; GetConverged() then returns true
  * and CurrentIteration tells where it stopped. NumberOfIterations remains the
  * cap.
+ *
+ * Oscillation damping (DampOscillations, off by default): an explicit step
+ * overshoots where a force changes direction within less than a step (a thin
+ * gap between two structures, a sharp crest of the force field, a vertex
+ * whose normal flips as it crosses the plane of its neighbours); such a
+ * vertex then jumps back and forth by the step bound for ever, and the
+ * largest displacement never falls below ConvergenceTolerance. With the
+ * damping on, each vertex keeps a step factor in [1/1024, 1]: a displacement
+ * that reverses the vertex's previous one (an angle above 120 degrees)
+ * halves it, any other displacement multiplies it by 1.25, and the vertex
+ * moves by the factor times its displacement. A vertex that moves steadily
+ * keeps the factor 1 (its motion is unchanged); an oscillating one settles
+ * where the force changes sign. GetNumberOfDampedVertices() gives the
+ * reversals of the last iteration.
  *
  * The step runs on flat arrays unpacked once in Reset(): coordinates and a CSR
  * vertex-neighbour table in which the neighbours of a vertex whose triangles
@@ -472,6 +487,19 @@ public:
   itkSetClampMacro(ConvergenceWindow, unsigned int, 1, NumericTraits<unsigned int>::max());
   itkGetConstMacro(ConvergenceWindow, unsigned int);
 
+  /** With ConvergenceFraction f > 0, an iteration is quiet when at most
+   * f x (number of points) vertices move by ConvergenceTolerance or more
+   * (0: when no vertex does, the largest displacement below the tolerance).
+   * A few vertices that keep creeping (into a narrow cleft, along a thin
+   * structure) then do not hold the whole surface. [0, 1), default 0. */
+  itkSetClampMacro(ConvergenceFraction, double, 0.0, 1.0);
+  itkGetConstMacro(ConvergenceFraction, double);
+
+  /** Vertices that moved by ConvergenceTolerance or more in the last
+   * iteration (counted when ConvergenceFraction > 0 or DampOscillations is
+   * on; 0 otherwise). */
+  itkGetConstMacro(NumberOfActiveVertices, SizeValueType);
+
   /** When on, no step makes the surface intersect itself: after each step
    * the pairs of triangles sharing no vertex whose new positions intersect,
    * or come closer than MinimumDistance (and closer than before the step),
@@ -503,6 +531,16 @@ public:
    * would stiffen the surface. Must be finite and non-negative. Default: 0. */
   itkSetMacro(MinimumDistance, double);
   itkGetConstMacro(MinimumDistance, double);
+
+  /** Per-vertex damping of displacements that reverse the previous one
+   * (see the class documentation). Off by default. */
+  itkSetMacro(DampOscillations, bool);
+  itkGetConstMacro(DampOscillations, bool);
+  itkBooleanMacro(DampOscillations);
+
+  /** Vertices whose displacement reversed their previous one in the last
+   * iteration (DampOscillations on; 0 otherwise). */
+  itkGetConstMacro(NumberOfDampedVertices, SizeValueType);
 
   /** Near-collisions handled by PreventSelfIntersections: pairs of
    * triangles found violating the constraint in the last iteration (each
@@ -725,6 +763,14 @@ private:
   void
   ConstrainSelfIntersections(std::vector<double> & blockMaximum, bool diagnose);
 
+  /** After the step, when DampOscillations is on or ConvergenceFraction > 0:
+   * scales each vertex's proposed displacement (from start to
+   * m_NextCoordinates) by its step factor and updates the factors and the
+   * blocks' largest displacements (DampOscillations), and counts the vertices
+   * that move by ConvergenceTolerance or more. */
+  void
+  FinishStep(const double * start, std::vector<double> & blockMaximum, bool diagnose);
+
   /** The checks of the image terms' parameters (VerifyPreconditions()). */
   void
   VerifyImageTermParameters() const;
@@ -785,6 +831,8 @@ private:
   unsigned int  m_BackgroundUpdateInterval{ 10 };
   double        m_ConvergenceTolerance{ 0.0 };
   unsigned int  m_ConvergenceWindow{ 3 };
+  double        m_ConvergenceFraction{ 0.0 };
+  SizeValueType m_NumberOfActiveVertices{ 0 };
   bool          m_FixedBoundary{ false };
   SizeValueType m_NumberOfClosedContours{ 0 };
   SizeValueType m_NumberOfOpenContours{ 0 };
@@ -802,6 +850,10 @@ private:
   std::vector<IndexType32> m_Triangles;
   DeformableMeshRemesher   m_Remesher;
   bool                     m_PreventSelfIntersections{ false };
+  bool                     m_DampOscillations{ false };
+  SizeValueType            m_NumberOfDampedVertices{ 0 };
+  /** Per vertex: the previous displacement (x, y, z) and the step factor. */
+  std::vector<std::array<float, 4>> m_OscillationState;
   double                   m_MinimumDistance{ 0.0 };
   SizeValueType            m_NumberOfCollisionsPrevented{ 0 };
   SizeValueType            m_TotalNumberOfCollisionsPrevented{ 0 };

@@ -938,6 +938,8 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
   m_Converged = false;
   m_QuietIterations = 0;
   m_LastMaximumDisplacement = 0.0;
+  m_OscillationState.clear();
+  m_NumberOfDampedVertices = 0;
   m_NormalSpeeds.clear();
   m_EdgeHits.clear();
   m_NumberOfEdgeHits = 0;
@@ -1057,6 +1059,102 @@ DeformableMeshFilter<TMesh, TForceImage>::ConstrainSelfIntersections(std::vector
       largest = std::max(largest, length(i));
     }
     blockMaximum[block] = largest;
+  }
+}
+
+template <typename TMesh, typename TForceImage>
+void
+DeformableMeshFilter<TMesh, TForceImage>::FinishStep(const double *        start,
+                                                                 std::vector<double> & blockMaximum,
+                                                                 bool                  diagnose)
+{
+  using namespace DeformableMeshFilterDetail;
+  const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
+  if (m_DampOscillations && m_OscillationState.size() != numberOfPoints)
+  {
+    m_OscillationState.assign(numberOfPoints, { { 0.0f, 0.0f, 0.0f, 1.0f } });
+  }
+  const SizeValueType        numberOfBlocks = blockMaximum.size();
+  std::vector<SizeValueType> blockDamped(numberOfBlocks, 0);
+  std::vector<SizeValueType> blockActive(numberOfBlocks, 0);
+  const bool                 damp = m_DampOscillations;
+  const double               squaredTolerance = m_ConvergenceTolerance * m_ConvergenceTolerance;
+  double *                   next = m_NextCoordinates.data();
+  MultiThreaderBase *        threader = this->GetMultiThreader();
+  threader->ParallelizeArray(
+    0,
+    numberOfBlocks,
+    [&](SizeValueType block) {
+      const SizeValueType begin = block * BlockSize;
+      const SizeValueType end = std::min(numberOfPoints, begin + BlockSize);
+      double              largest = 0.0;
+      SizeValueType       damped = 0;
+      SizeValueType       active = 0;
+      for (SizeValueType i = begin; i < end; ++i)
+      {
+        if (!damp)
+        {
+          const double d[3] = { next[3 * i] - start[3 * i],
+                                next[3 * i + 1] - start[3 * i + 1],
+                                next[3 * i + 2] - start[3 * i + 2] };
+          active += d[0] * d[0] + d[1] * d[1] + d[2] * d[2] >= squaredTolerance;
+          continue;
+        }
+        std::array<float, 4> & state = m_OscillationState[i];
+        double                 d[3] = { next[3 * i] - start[3 * i],
+                        next[3 * i + 1] - start[3 * i + 1],
+                        next[3 * i + 2] - start[3 * i + 2] };
+        const double           dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        const double           pp = double{ state[0] } * state[0] + double{ state[1] } * state[1] +
+                          double{ state[2] } * state[2];
+        const double dp = d[0] * state[0] + d[1] * state[1] + d[2] * state[2];
+        // Reversal: the angle between the two displacements above 120 degrees.
+        if (dp < 0.0 && 4.0 * dp * dp > dd * pp)
+        {
+          state[3] = std::max(state[3] * 0.5f, 1.0f / 1024.0f);
+          ++damped;
+        }
+        else
+        {
+          state[3] = std::min(state[3] * 1.25f, 1.0f);
+        }
+        const double factor = state[3];
+        if (factor < 1.0)
+        {
+          for (unsigned int k = 0; k < 3; ++k)
+          {
+            d[k] *= factor;
+            next[3 * i + k] = start[3 * i + k] + d[k];
+          }
+        }
+        if (dd > 0.0)
+        {
+          // The previous displacement keeps its direction while the vertex
+          // stands still.
+          state[0] = static_cast<float>(d[0]);
+          state[1] = static_cast<float>(d[1]);
+          state[2] = static_cast<float>(d[2]);
+        }
+        const double squared = factor * factor * dd;
+        largest = std::max(largest, squared);
+        active += squared >= squaredTolerance;
+        if (diagnose)
+        {
+          m_DisplacementMagnitudes[i] = static_cast<float>(std::sqrt(squared));
+        }
+      }
+      if (damp)
+      {
+        blockMaximum[block] = std::sqrt(largest);
+      }
+      blockDamped[block] = damped;
+      blockActive[block] = active;
+    },
+    nullptr);
+  for (SizeValueType block = 0; block < numberOfBlocks; ++block)
+  {
+    m_NumberOfDampedVertices += blockDamped[block];
+    m_NumberOfActiveVertices += blockActive[block];
   }
 }
 
@@ -1296,6 +1394,12 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
     }
   }
 
+  m_NumberOfDampedVertices = 0;
+  m_NumberOfActiveVertices = 0;
+  if (m_DampOscillations || m_ConvergenceFraction > 0.0)
+  {
+    this->FinishStep(m_NumberOfSubSteps > 1 ? m_IterationStart.data() : coordinates.data(), blockMaximum, diagnose);
+  }
   if (m_PreventSelfIntersections)
   {
     this->ConstrainSelfIntersections(blockMaximum, diagnose);
@@ -1303,7 +1407,14 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   coordinates.swap(m_NextCoordinates);
 
   m_LastMaximumDisplacement = *std::max_element(blockMaximum.begin(), blockMaximum.end());
-  if (m_ConvergenceTolerance > 0.0 && m_LastMaximumDisplacement < m_ConvergenceTolerance)
+  // Quiet: the largest displacement below the tolerance, or with
+  // ConvergenceFraction > 0, at most that fraction of the vertices moving by
+  // the tolerance or more.
+  const bool quiet =
+    m_ConvergenceFraction > 0.0
+      ? static_cast<double>(m_NumberOfActiveVertices) <= m_ConvergenceFraction * static_cast<double>(numberOfPoints)
+      : m_LastMaximumDisplacement < m_ConvergenceTolerance;
+  if (m_ConvergenceTolerance > 0.0 && quiet)
   {
     m_Converged = ++m_QuietIterations >= m_ConvergenceWindow;
   }
@@ -1444,6 +1555,7 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
     values.swap(mapped);
   };
   remap(m_BalloonReleased);
+  remap(m_OscillationState);
   remap(m_DisplacementMagnitudes);
   remap(m_ExternalForceMagnitudes);
   remap(m_InternalForceMagnitudes);
@@ -1500,6 +1612,10 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "MaximumStepLength: " << m_MaximumStepLength << std::endl;
   os << indent << "ConvergenceTolerance: " << m_ConvergenceTolerance << std::endl;
   os << indent << "ConvergenceWindow: " << m_ConvergenceWindow << std::endl;
+  os << indent << "ConvergenceFraction: " << m_ConvergenceFraction << std::endl;
+  os << indent << "NumberOfActiveVertices: " << m_NumberOfActiveVertices << std::endl;
+  os << indent << "DampOscillations: " << (m_DampOscillations ? "On" : "Off") << std::endl;
+  os << indent << "NumberOfDampedVertices: " << m_NumberOfDampedVertices << std::endl;
   os << indent << "FixedBoundary: " << (m_FixedBoundary ? "On" : "Off") << " (" << m_BoundaryVertices.size()
      << " boundary vertices)" << std::endl;
   os << indent << "Contours: " << m_NumberOfClosedContours << " closed, " << m_NumberOfOpenContours << " open"

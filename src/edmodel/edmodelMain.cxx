@@ -513,7 +513,8 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
   t.push_back({ model,
                 "--iterations",
                 "N",
-                "largest number of iterations of each resolution level (0 writes the initial mesh)",
+                "largest number of iterations of each resolution level; the first of several (the capture level) runs "
+                "up to " + std::to_string(defaults::CaptureIterations) + " when this is lower (0 writes the initial mesh)",
                 std::to_string(defaults::Iterations),
                 [&o](const std::string & s) { o.iterations = ParseUnsigned("--iterations", s); } });
   t.push_back({ model,
@@ -535,6 +536,27 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                   o.convergenceWindow = ParseUnsigned("--window", s);
                   RequireAtLeast("--window", o.convergenceWindow, 1);
                 } });
+  t.push_back({ model,
+                "--active-fraction",
+                "F",
+                "a level is quiet when at most this fraction of its vertices move by --tolerance or more (0: when "
+                "none does); a few vertices creeping into a narrow cleft then do not hold the whole surface, in [0, 1)",
+                FormatNumber(defaults::ConvergenceFraction),
+                [&o](const std::string & s) {
+                  o.convergenceFraction = ParseDouble("--active-fraction", s);
+                  RequireAtLeast("--active-fraction", o.convergenceFraction, 0.0);
+                  if (!(o.convergenceFraction < 1.0))
+                  {
+                    throw Error("--active-fraction must be below 1; it is " + s);
+                  }
+                } });
+  t.push_back({ model,
+                "--no-damping",
+                "",
+                "do not damp the step of vertices whose displacement reverses their previous one (a vertex "
+                "jumping back and forth across a thin gap or a sharp crest of the force never converges)",
+                "damping on",
+                [&o](const std::string &) { o.dampOscillations = false; } });
   AddGlobalOptions(t, global, "General");
   return t;
 }

@@ -70,7 +70,13 @@ constexpr bool TangentialElasticity = false;
 constexpr bool         ContourTangentialElasticity = true;
 constexpr double       Rigidity = 0.05;
 constexpr unsigned int Iterations = 500;
+/** Iteration cap of the capture level (the first of several coarse-to-fine
+ * levels) when --iterations is lower. */
+constexpr unsigned int CaptureIterations = 2000;
 constexpr double       ConvergenceTolerance = 0.02;
+/** A level is quiet when at most this fraction of its vertices move by the
+ * tolerance or more (the filter's ConvergenceFraction). */
+constexpr double ConvergenceFraction = 0.005;
 /** Subdivisions of the octahedron of --init-sphere (4 * 4^n + 2 points). */
 constexpr unsigned int SphereResolution = 4;
 /** Radius of the default initial sphere, as a fraction of the smallest
@@ -148,6 +154,7 @@ struct SegmentOptions
   std::string  initMesh;
   std::string  forceOutput;
   std::string  snapshots;
+  bool         dampOscillations{ true };
   bool         hasInitSphere{ false };
   double       sphere[4]{ 0.0, 0.0, 0.0, 0.0 }; // centre x, y, z and radius
   unsigned int sphereResolution{ defaults::SphereResolution };
@@ -186,6 +193,7 @@ struct SegmentOptions
   unsigned int iterations{ defaults::Iterations };
   double       convergenceTolerance{ defaults::ConvergenceTolerance };
   unsigned int convergenceWindow{ GetCoreDefaults().ConvergenceWindow };
+  double       convergenceFraction{ defaults::ConvergenceFraction };
   unsigned int snapshotEvery{ defaults::SnapshotEvery };
   bool         snapshotEverySet{ false };
 };

@@ -501,13 +501,21 @@ Deform(const ImageType *        image,
     {
       deform->SetObjectIntensityStatistics(model[0], model[1]);
     }
+    deform->SetDampOscillations(o.dampOscillations);
     deform->SetPreventSelfIntersections(o.preventSelfIntersections);
     deform->SetMinimumDistance(o.minimumDistance);
     deform->SetMaximumStepLength(o.maximumStepLength);
     deform->SetFixedBoundary(o.fixedBoundary);
     deform->SetConvergenceTolerance(o.convergenceTolerance);
     deform->SetConvergenceWindow(o.convergenceWindow);
-    deform->SetNumberOfIterations(o.iterations);
+    deform->SetConvergenceFraction(o.convergenceFraction);
+    // The capture level runs until it converges, up to CaptureIterations
+    // (or --iterations when larger): from a small sphere it travels far, and
+    // its front slows down as it fills narrow lobes (ch2: 700 iterations),
+    // so that a cap of 500 would stop it anywhere along the way and the
+    // result would depend on --iterations.
+    deform->SetNumberOfIterations(capture && o.iterations > 0 ? std::max(o.iterations, defaults::CaptureIterations)
+                                                              : o.iterations);
     const std::string level = std::to_string(stageInput->GetNumberOfPoints()) + " points";
     progress.Start("deforming");
     const auto deformStart = std::chrono::steady_clock::now();
@@ -559,9 +567,17 @@ Deform(const ImageType *        image,
     result.lastMaximumDisplacement = deform->GetLastMaximumDisplacement();
     const double deformSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - deformStart).count();
     progress.Finish(std::to_string(deform->GetCurrentIteration()) + " iterations on " + level + ", " +
-                    (result.converged ? "converged (largest step below " + Format(o.convergenceTolerance) + " mm for " +
-                                          std::to_string(o.convergenceWindow) + " iterations)"
-                                      : std::string("iteration cap reached")) +
+                    (result.converged
+                       ? "converged (" +
+                           (o.convergenceFraction > 0.0
+                              ? "at most " +
+                                  std::to_string(static_cast<unsigned long long>(
+                                    o.convergenceFraction * static_cast<double>(stageInput->GetNumberOfPoints()))) +
+                                  " vertices moving by "
+                              : std::string("largest step below ")) +
+                           Format(deform->GetConvergenceTolerance()) + " mm for " +
+                           std::to_string(o.convergenceWindow) + " iterations)"
+                       : std::string("iteration cap reached")) +
                     ", last largest step " + Format(result.lastMaximumDisplacement) + " mm (" +
                     Format(deformSeconds, 2) + " s)");
     MeshType::Pointer output = deform->GetOutput();
