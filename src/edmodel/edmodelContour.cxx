@@ -1084,10 +1084,15 @@ DeformContours(const Image2DType *     image,
       deform->SetObjectIntensityStatistics(model[0], model[1]);
     }
     deform->SetFixedBoundary(o.fixedBoundary);
+    deform->SetDampOscillations(o.dampOscillations);
     deform->SetMaximumStepLength(o.maximumStepLength);
     deform->SetConvergenceTolerance(o.convergenceTolerance);
     deform->SetConvergenceWindow(o.convergenceWindow);
-    deform->SetNumberOfIterations(o.iterations);
+    deform->SetConvergenceFraction(o.convergenceFraction);
+    // As in 3-D, the capture level runs until it converges, up to
+    // CaptureIterations (or --iterations when larger).
+    deform->SetNumberOfIterations(capture && o.iterations > 0 ? std::max(o.iterations, defaults::CaptureIterations)
+                                                              : o.iterations);
     const std::string level = std::to_string(CountPoints(stageInput)) + " points";
     progress.Start("deforming");
     const auto deformStart = std::chrono::steady_clock::now();
@@ -1139,12 +1144,19 @@ DeformContours(const Image2DType *     image,
     result.converged = deform->GetConverged();
     result.lastMaximumDisplacement = deform->GetLastMaximumDisplacement();
     const double deformSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - deformStart).count();
-    progress.Finish(std::to_string(deform->GetCurrentIteration()) + " iterations on " + level + ", " +
-                    (result.converged ? "converged (largest step below " + Format(o.convergenceTolerance) + " mm for " +
-                                          std::to_string(o.convergenceWindow) + " iterations)"
-                                      : std::string("iteration cap reached")) +
-                    ", last largest step " + Format(result.lastMaximumDisplacement) + " mm (" +
-                    Format(deformSeconds, 2) + " s)");
+    progress.Finish(
+      std::to_string(deform->GetCurrentIteration()) + " iterations on " + level + ", " +
+      (result.converged
+         ? "converged (" +
+             (o.convergenceFraction > 0.0 ? "at most " +
+                                              std::to_string(static_cast<unsigned long long>(
+                                                o.convergenceFraction * static_cast<double>(CountPoints(stageInput)))) +
+                                              " points moving by "
+                                          : std::string("largest step below ")) +
+             Format(deform->GetConvergenceTolerance()) + " mm for " + std::to_string(o.convergenceWindow) +
+             " iterations)"
+         : std::string("iteration cap reached")) +
+      ", last largest step " + Format(result.lastMaximumDisplacement) + " mm (" + Format(deformSeconds, 2) + " s)");
     const bool fine =
       !(MeanEdgeLength(output) > 1.5 * edgeLength) || 2.0 * static_cast<double>(CountPoints(output)) > maximumPoints;
     if (last || (stage > 0 && fine))
