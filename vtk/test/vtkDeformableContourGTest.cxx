@@ -185,13 +185,22 @@ struct Ellipse
       (g(middle) > 0.0 ? low : high) = middle;
     }
     const double t = 0.5 * (low + high);
-    double       squared = 0.0;
+    double       closest[2];
     for (int k = 0; k < 2; ++k)
     {
-      const double closest = std::min(r[k] * r[k] * z[k] / (t + r[k] * r[k]), r[k]);
-      squared += (z[k] - closest) * (z[k] - closest);
+      closest[k] = std::min(r[k] * r[k] * z[k] / (t + r[k] * r[k]), r[k]);
     }
-    return std::sqrt(squared);
+    // On the major axis near the centre the root is -b^2 itself (0 / 0 above):
+    // the closest point is then off the axis, on the ellipse.
+    for (int k = 0; k < 2; ++k)
+    {
+      if (!std::isfinite(closest[k]))
+      {
+        const double other = closest[1 - k] / r[1 - k];
+        closest[k] = r[k] * std::sqrt(std::max(0.0, 1.0 - other * other));
+      }
+    }
+    return std::hypot(z[0] - closest[0], z[1] - closest[1]);
   }
 };
 
