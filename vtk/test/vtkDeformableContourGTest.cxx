@@ -989,3 +989,34 @@ TEST(VTKDeformableContour, BadInputGivesAnErrorAndAnEmptyOutput)
   EXPECT_NE(forceErrors.Take().find("nx x ny x 1"), std::string::npos);
   EXPECT_EQ(forceField->GetOutput()->GetNumberOfPoints(), 0);
 }
+
+// A slice of a volume (extent k = 5 along z, z spacing 2, origin z 1, as
+// vtkExtractVOI gives it): the contour ends on the ellipse in the slice's
+// plane, z = 1 + 5 x 2 = 11.
+TEST(VTKDeformableContour, ASliceOfAVolumeKeepsItsPlane)
+{
+  const auto image = MakeImage(TestGeometry(), { TestEllipse });
+  vtkNew<vtkImageData> slice;
+  slice->SetExtent(0, 71, 0, 71, 5, 5);
+  slice->SetOrigin(0.0, 0.0, 1.0);
+  slice->SetSpacing(1.0, 1.0, 2.0);
+  slice->GetPointData()->SetScalars(image->GetPointData()->GetScalars());
+  const auto forces = MakeForces(slice);
+  ASSERT_EQ(forces->GetOutput()->GetNumberOfPoints(), 72 * 72);
+  const auto circle = MakeCircle(TestEllipse.center[0], TestEllipse.center[1], 17.0, 200, 0.0);
+  vtkNew<vtkDeformableMesh> deformable;
+  deformable->SetInputData(circle);
+  deformable->SetForceImageConnection(forces->GetOutputPort());
+  deformable->SetScaleFactor(0.5);
+  deformable->SetElasticity(0.3);
+  deformable->SetNumberOfIterations(400);
+  deformable->Update();
+  ASSERT_EQ(deformable->GetOutput()->GetNumberOfPoints(), 200);
+  double mean = 0.0;
+  double maximum = 0.0;
+  MeasureDistance(deformable->GetOutput(), TestEllipse, mean, maximum);
+  EXPECT_LE(mean, 0.1);
+  EXPECT_LE(maximum, 0.3);
+  EXPECT_EQ(deformable->GetOutput()->GetBounds()[4], 11.0);
+  EXPECT_EQ(deformable->GetOutput()->GetBounds()[5], 11.0);
+}
