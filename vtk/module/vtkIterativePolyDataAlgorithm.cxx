@@ -264,4 +264,6 @@ vtkIterativePolyDataAlgorithm::PrintSelf(ostream & os, vtkIndent indent)
      << " points\n";
   os << indent << "ITKFilter: " << (this->Internals->Filter ? this->Internals->Filter->GetNameOfClass() : "(none)")
      << "\n";
+  os << indent << "ContourITKFilter: "
+     << (this->Internals->ContourFilter ? this->Internals->ContourFilter->GetNameOfClass() : "(none)") << "\n";
 }
