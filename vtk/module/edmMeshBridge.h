@@ -649,8 +649,8 @@ PolyDataToMesh(vtkPolyData *             polyData,
       result.PointArrayName = array->GetName() != nullptr ? array->GetName() : "";
     }
   }
-  if (options.CellData && !options.PolyLinesAsSegments && static_cast<vtkIdType>(cellId) == polyData->GetNumberOfCells() &&
-      cellId > 0)
+  if (options.CellData && !options.PolyLinesAsSegments &&
+      static_cast<vtkIdType>(cellId) == polyData->GetNumberOfCells() && cellId > 0)
   {
     if (vtkDataArray * array =
           detail::ChooseArray<typename TMesh::CellPixelType>(polyData->GetCellData(), options.CellArrayName))

@@ -109,12 +109,12 @@ public:
   using ContourForceImageType = itk::Image<itk::CovariantVector<float, 2>, 2>;
   using ContourFilterType = itk::DeformableMeshFilter<ContourMeshType, ContourForceImageType>;
 
-  FilterType::Pointer                                    Filter;
-  ConvertedImage<ForceImageType>                         ForceImage;
-  ConvertedImage<FilterType::IntensityImageType>         IntensityImage; // the region force's (second array)
-  ContourFilterType::Pointer                             ContourFilter;
-  ConvertedImage<ContourForceImageType>                  ContourForceImage;
-  ConvertedImage<ContourFilterType::IntensityImageType>  ContourIntensityImage;
+  FilterType::Pointer                                   Filter;
+  ConvertedImage<ForceImageType>                        ForceImage;
+  ConvertedImage<FilterType::IntensityImageType>        IntensityImage; // the region force's (second array)
+  ContourFilterType::Pointer                            ContourFilter;
+  ConvertedImage<ContourForceImageType>                 ContourForceImage;
+  ConvertedImage<ContourFilterType::IntensityImageType> ContourIntensityImage;
 };
 
 //------------------------------------------------------------------------------
@@ -230,10 +230,10 @@ vtkDeformableMesh::RequestMeshDimension(vtkPolyData * input, vtkInformationVecto
       if (bounds[5] - bounds[4] <= 1e-9 * size)
       {
         vtkErrorMacro("The input is a 2-D contour (" << lines << " line(s) in the plane z = " << bounds[4]
-                                                      << "), but the force image on input port 1 is 3-D ("
-                                                      << extentText()
-                                                      << " points): a contour needs a 2-D image of nx x ny x 1 "
-                                                         "points (for example one slice, vtkExtractVOI).");
+                                                     << "), but the force image on input port 1 is 3-D ("
+                                                     << extentText()
+                                                     << " points): a contour needs a 2-D image of nx x ny x 1 "
+                                                        "points (for example one slice, vtkExtractVOI).");
         return 0;
       }
     }
@@ -413,9 +413,9 @@ vtkDeformableMesh::PrepareFilter(vtkInformationVector ** inputVector)
     filter->SetConvergenceWindow(static_cast<unsigned int>(this->ConvergenceWindow));
     return 1;
   };
-  return contours ? prepare(internals.ContourFilter.GetPointer(), internals.ContourForceImage,
-                            internals.ContourIntensityImage)
-                  : prepare(internals.Filter.GetPointer(), internals.ForceImage, internals.IntensityImage);
+  return contours
+           ? prepare(internals.ContourFilter.GetPointer(), internals.ContourForceImage, internals.ContourIntensityImage)
+           : prepare(internals.Filter.GetPointer(), internals.ForceImage, internals.IntensityImage);
 }
 
 //------------------------------------------------------------------------------

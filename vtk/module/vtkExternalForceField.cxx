@@ -145,8 +145,8 @@ vtkExternalForceField::RequestData(vtkInformation *,
   vtkSmartPointer<vtkDataArray> force;
   auto                          run = [&](auto dimension) {
     constexpr unsigned int Dimension = decltype(dimension)::value;
-    auto intensity = edm::ImageDataToImage<IntensityImageType<Dimension>>(input, array);
-    auto filter = ForceFilterType<Dimension>::New();
+    auto                   intensity = edm::ImageDataToImage<IntensityImageType<Dimension>>(input, array);
+    auto                   filter = ForceFilterType<Dimension>::New();
     filter->SetInput(intensity);
     filter->SetSigma(this->Sigma);
     filter->SetNormalizeForces(this->NormalizeForces != 0);
@@ -165,7 +165,7 @@ vtkExternalForceField::RequestData(vtkInformation *,
       itkGenericExceptionMacro("the force image has " << field->GetBufferedRegion().GetNumberOfPixels()
                                                       << " pixels, the input " << numberOfPoints << " points.");
     }
-    auto            values = vtkSmartPointer<vtkFloatArray>::New();
+    auto values = vtkSmartPointer<vtkFloatArray>::New();
     values->SetName("Force");
     values->SetNumberOfComponents(3);
     values->SetNumberOfTuples(numberOfPoints);

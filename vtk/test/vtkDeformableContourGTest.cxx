@@ -277,7 +277,7 @@ MakeImage(const Geometry & g, const std::vector<Ellipse> & ellipses)
 vtkSmartPointer<vtkPolyData>
 MakeCircle(double cx, double cy, double radius, int n, double z, bool polyline = true)
 {
-  auto          polyData = vtkSmartPointer<vtkPolyData>::New();
+  auto              polyData = vtkSmartPointer<vtkPolyData>::New();
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   for (int k = 0; k < n; ++k)
@@ -315,9 +315,9 @@ MakeOpenContour(double ax, double ay, double bx, double by, int n, double bow, d
   auto              polyData = vtkSmartPointer<vtkPolyData>::New();
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
-  const double dx = bx - ax;
-  const double dy = by - ay;
-  const double length = std::hypot(dx, dy);
+  const double         dx = bx - ax;
+  const double         dy = by - ay;
+  const double         length = std::hypot(dx, dy);
   vtkNew<vtkCellArray> lines;
   lines->InsertNextCell(n);
   for (int k = 0; k < n; ++k)
@@ -347,7 +347,7 @@ Coordinates(vtkPolyData * polyData)
 /** The test case of the ITK filter's known answer: an ellipse of semi-axes
  * (20, 14) pixels centred at (35.3, 36.1) in a 72 x 72 image, the plane
  * z = -3.25, and a circle of radius 17 and 200 points at its centre. */
-const Ellipse TestEllipse{ { 35.3, 36.1 }, 20.0, 14.0, 0.0 };
+const Ellipse    TestEllipse{ { 35.3, 36.1 }, 20.0, 14.0, 0.0 };
 constexpr double PlaneZ = -3.25;
 
 Geometry
@@ -411,8 +411,8 @@ TEST(VTKDeformableContour, ForceFieldOfA2DImageIsThe2DITKFilter)
   Geometry g = TestGeometry();
   g.spacing[0] = 0.75;
   g.rotation = 0.3;
-  const auto image = MakeImage(g, { TestEllipse });
-  const auto forces = MakeForces(image);
+  const auto     image = MakeImage(g, { TestEllipse });
+  const auto     forces = MakeForces(image);
   vtkImageData * output = forces->GetOutput();
   ASSERT_EQ(output->GetNumberOfPoints(), image->GetNumberOfPoints());
   EXPECT_EQ(output->GetOrigin()[2], PlaneZ);
@@ -559,10 +559,10 @@ TEST(VTKDeformableContour, SeveralContoursInOnePolydata)
 
   // The left circle as a closed polyline, the right one as two-point lines,
   // and an open polyline across the bottom of the left ellipse.
-  const auto        a = MakeCircle(left.center[0], left.center[1], 17.0, 160, 0.0, true);
-  const auto        b = MakeCircle(right.center[0], right.center[1], 15.5, 140, 0.0, false);
-  const auto        c = MakeOpenContour(left.center[0] - 12.0, left.center[1] - 9.0, left.center[0] + 12.0,
-                                 left.center[1] - 9.0, 41, -3.0, 0.0);
+  const auto a = MakeCircle(left.center[0], left.center[1], 17.0, 160, 0.0, true);
+  const auto b = MakeCircle(right.center[0], right.center[1], 15.5, 140, 0.0, false);
+  const auto c = MakeOpenContour(
+    left.center[0] - 12.0, left.center[1] - 9.0, left.center[0] + 12.0, left.center[1] - 9.0, 41, -3.0, 0.0);
   vtkNew<vtkPolyData>  contours;
   vtkNew<vtkPoints>    points;
   vtkNew<vtkCellArray> lines;
@@ -642,8 +642,13 @@ TEST(VTKDeformableContour, OpenContourWithFixedBoundaryKeepsItsEnds)
 {
   const auto image = MakeImage(TestGeometry(), { TestEllipse });
   const auto forces = MakeForces(image);
-  const auto open = MakeOpenContour(TestEllipse.center[0] - 12.0, TestEllipse.center[1] - 9.0,
-                                    TestEllipse.center[0] + 12.0, TestEllipse.center[1] - 9.0, 41, -3.0, PlaneZ);
+  const auto open = MakeOpenContour(TestEllipse.center[0] - 12.0,
+                                    TestEllipse.center[1] - 9.0,
+                                    TestEllipse.center[0] + 12.0,
+                                    TestEllipse.center[1] - 9.0,
+                                    41,
+                                    -3.0,
+                                    PlaneZ);
   for (const bool fixed : { true, false })
   {
     vtkNew<vtkDeformableMesh> deformable;
@@ -789,7 +794,7 @@ TEST(VTKDeformableContour, SeriesWriterWritesAContourSeries)
   deformable->SetForceImageConnection(forces->GetOutputPort());
   deformable->SetScaleFactor(0.5);
   deformable->SetElasticity(0.3);
-  const std::string          collection = std::string(EDM_TEST_OUTPUT_DIRECTORY) + "/contour-series.pvd";
+  const std::string                collection = std::string(EDM_TEST_OUTPUT_DIRECTORY) + "/contour-series.pvd";
   vtkNew<vtkIterationSeriesWriter> writer;
   writer->SetFileName(collection.c_str());
   writer->SetAlgorithm(deformable);
@@ -826,9 +831,9 @@ TEST(VTKDeformableContour, SeriesWriterWritesAContourSeries)
 // 2-D ITK filter's.
 TEST(VTKDeformableContour, RegionForceIsThe2DITKFilters)
 {
-  const auto image = MakeImage(TestGeometry(), { TestEllipse });
-  const auto forces = MakeForces(image);
-  const auto circle = MakeCircle(TestEllipse.center[0], TestEllipse.center[1], 8.0, 100, 0.0);
+  const auto                image = MakeImage(TestGeometry(), { TestEllipse });
+  const auto                forces = MakeForces(image);
+  const auto                circle = MakeCircle(TestEllipse.center[0], TestEllipse.center[1], 8.0, 100, 0.0);
   vtkNew<vtkDeformableMesh> deformable;
   deformable->SetInputData(circle);
   deformable->SetForceImageConnection(forces->GetOutputPort());
@@ -840,8 +845,8 @@ TEST(VTKDeformableContour, RegionForceIsThe2DITKFilters)
   ASSERT_EQ(deformable->GetOutput()->GetNumberOfPoints(), 100);
 
   auto reference = ReferenceFilter(circle, image);
-  reference->SetIntensityImage(edm::ImageDataToImage<ContourFilterType::IntensityImageType>(
-    image, image->GetPointData()->GetArray("Intensity")));
+  reference->SetIntensityImage(
+    edm::ImageDataToImage<ContourFilterType::IntensityImageType>(image, image->GetPointData()->GetArray("Intensity")));
   reference->SetScaleFactor(0.25);
   reference->SetElasticity(0.3);
   reference->SetRegionWeight(0.25);
@@ -995,7 +1000,7 @@ TEST(VTKDeformableContour, BadInputGivesAnErrorAndAnEmptyOutput)
 // plane, z = 1 + 5 x 2 = 11.
 TEST(VTKDeformableContour, ASliceOfAVolumeKeepsItsPlane)
 {
-  const auto image = MakeImage(TestGeometry(), { TestEllipse });
+  const auto           image = MakeImage(TestGeometry(), { TestEllipse });
   vtkNew<vtkImageData> slice;
   slice->SetExtent(0, 71, 0, 71, 5, 5);
   slice->SetOrigin(0.0, 0.0, 1.0);
@@ -1003,7 +1008,7 @@ TEST(VTKDeformableContour, ASliceOfAVolumeKeepsItsPlane)
   slice->GetPointData()->SetScalars(image->GetPointData()->GetScalars());
   const auto forces = MakeForces(slice);
   ASSERT_EQ(forces->GetOutput()->GetNumberOfPoints(), 72 * 72);
-  const auto circle = MakeCircle(TestEllipse.center[0], TestEllipse.center[1], 17.0, 200, 0.0);
+  const auto                circle = MakeCircle(TestEllipse.center[0], TestEllipse.center[1], 17.0, 200, 0.0);
   vtkNew<vtkDeformableMesh> deformable;
   deformable->SetInputData(circle);
   deformable->SetForceImageConnection(forces->GetOutputPort());
