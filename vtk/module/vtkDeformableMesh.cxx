@@ -25,6 +25,9 @@
 #include "itkImage.h"
 
 #include "vtkAlgorithmOutput.h"
+#include "vtkCellArray.h"
+#include "vtkCellArrayIterator.h"
+#include "vtkIdList.h"
 #include "vtkDataArray.h"
 #include "vtkDataObject.h"
 #include "vtkDataSetAttributes.h"
@@ -257,6 +260,20 @@ vtkDeformableMesh::RequestMeshDimension(vtkPolyData * input, vtkInformationVecto
                   << " vertex cell(s). A 2-D model deforms contours; remove the other cells (for example "
                      "vtkRegularPolygonSource with GeneratePolygonOff).");
     return 0;
+  }
+  {
+    vtkCellArray * cells = input->GetLines();
+    vtkIdType      cellId = 0;
+    auto           iterator = vtk::TakeSmartPointer(cells->NewIterator());
+    for (iterator->GoToFirstCell(); !iterator->IsDoneWithTraversal(); iterator->GoToNextCell(), ++cellId)
+    {
+      if (iterator->GetCurrentCell()->GetNumberOfIds() < 2)
+      {
+        vtkErrorMacro("Line cell " << cellId << " has " << iterator->GetCurrentCell()->GetNumberOfIds()
+                                   << " point(s): a contour needs at least 2.");
+        return 0;
+      }
+    }
   }
   const vtkMatrix3x3 * direction = image->GetDirectionMatrix();
   for (int k = 0; k < 2; ++k)

@@ -934,6 +934,14 @@ TEST(VTKDeformableContour, BadInputGivesAnErrorAndAnEmptyOutput)
   deformable->SetInputData(withNaN);
   expectRefused("a NaN point", "non-finite coordinate");
 
+  // A line cell of one point.
+  vtkNew<vtkPolyData> withDot;
+  withDot->DeepCopy(circle);
+  const vtkIdType dot[1] = { 3 };
+  withDot->GetLines()->InsertNextCell(1, dot);
+  deformable->SetInputData(withDot);
+  expectRefused("a one-point line", "Line cell 1 has 1 point(s)");
+
   // Remeshing works on surfaces only.
   deformable->SetInputData(circle);
   deformable->SetRemeshingEdgeLength(1.0);
