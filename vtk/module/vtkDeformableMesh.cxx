@@ -142,6 +142,8 @@ vtkDeformableMesh::vtkDeformableMesh()
   this->FixedBoundary = filter->GetFixedBoundary() ? 1 : 0;
   this->ConvergenceTolerance = filter->GetConvergenceTolerance();
   this->ConvergenceWindow = static_cast<int>(filter->GetConvergenceWindow());
+  this->ConvergenceFraction = filter->GetConvergenceFraction();
+  this->DampOscillations = filter->GetDampOscillations() ? 1 : 0;
   this->RegionWeight = filter->GetRegionWeight();
   this->RegionSigma = filter->GetRegionSigma();
   this->EdgeSearchWeight = filter->GetEdgeSearchWeight();
@@ -428,6 +430,8 @@ vtkDeformableMesh::PrepareFilter(vtkInformationVector ** inputVector)
     filter->SetFixedBoundary(this->FixedBoundary != 0);
     filter->SetConvergenceTolerance(this->ConvergenceTolerance);
     filter->SetConvergenceWindow(static_cast<unsigned int>(this->ConvergenceWindow));
+    filter->SetConvergenceFraction(this->ConvergenceFraction);
+    filter->SetDampOscillations(this->DampOscillations != 0);
     return 1;
   };
   return contours
@@ -501,6 +505,8 @@ vtkDeformableMesh::PrintSelf(ostream & os, vtkIndent indent)
   os << indent << "FixedBoundary: " << (this->FixedBoundary ? "On" : "Off") << "\n";
   os << indent << "ConvergenceTolerance: " << this->ConvergenceTolerance << "\n";
   os << indent << "ConvergenceWindow: " << this->ConvergenceWindow << "\n";
+  os << indent << "ConvergenceFraction: " << this->ConvergenceFraction << "\n";
+  os << indent << "DampOscillations: " << (this->DampOscillations ? "On" : "Off") << "\n";
   os << indent << "ComputeDiagnostics: " << (this->ComputeDiagnostics ? "On" : "Off") << "\n";
   os << indent << "Converged: " << (this->Converged ? "true" : "false") << "\n";
   os << indent << "LastMaximumDisplacement: " << this->LastMaximumDisplacement << "\n";

@@ -342,6 +342,30 @@ public:
 
   ///@{
   /**
+   * With f > 0, an iteration is quiet when at most f x (number of points)
+   * vertices move by ConvergenceTolerance or more (0: when none does). In
+   * [0, 1]; default 0 (edmodel: 0.005).
+   * Meaning in full: itk::DeformableMeshFilter::SetConvergenceFraction().
+   */
+  vtkSetClampMacro(ConvergenceFraction, double, 0.0, 1.0);
+  vtkGetMacro(ConvergenceFraction, double);
+  ///@}
+
+  ///@{
+  /**
+   * Halve the step of a vertex whose displacement reverses its previous one
+   * (x1.25 back toward the full step otherwise), so that vertices jumping
+   * across a thin gap or a sharp crest of the force settle. Default off
+   * (edmodel: on).
+   * Meaning in full: itk::DeformableMeshFilter::SetDampOscillations().
+   */
+  vtkSetMacro(DampOscillations, vtkTypeBool);
+  vtkGetMacro(DampOscillations, vtkTypeBool);
+  vtkBooleanMacro(DampOscillations, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
    * Add the DisplacementMagnitude, ExternalForceMagnitude and
    * InternalForceMagnitude point arrays to the output. Default: On.
    */
@@ -403,6 +427,8 @@ protected:
   vtkTypeBool FixedBoundary = 0;
   double      ConvergenceTolerance = 0.0;
   int         ConvergenceWindow = 3;
+  double      ConvergenceFraction = 0.0;
+  vtkTypeBool DampOscillations = 0;
   vtkTypeBool ComputeDiagnostics = 1;
   vtkTypeBool Converged = 0;
   double      LastMaximumDisplacement = 0.0;
