@@ -221,7 +221,8 @@ DeformableMeshFilter<TMesh, TForceImage>::GatherInputCells(std::vector<IndexType
       onlyTriangles = onlyTriangles && type == CommonEnums::CellGeometry::TRIANGLE_CELL && n == 3;
       if (PointDimension == 2)
       {
-        // Contours: line cells (a segment each, chained into open or closed
+        // Contours: line cells (a segment each, or a chain of segments for a
+        // line cell of more than 2 points, chained into open or closed
         // contours) and polygon cells (a closed contour each, its points in
         // order); ITK 5.2 has no polyline cell.
         const bool isPolygon = type == CommonEnums::CellGeometry::POLYGON_CELL;
@@ -237,14 +238,19 @@ DeformableMeshFilter<TMesh, TForceImage>::GatherInputCells(std::vector<IndexType
         {
           distinct -= ids[k] == ids[(k + 1) % n] ? 1 : 0;
         }
-        if (isPolygon ? distinct < 3 : (n < 2 || ids[0] == ids[1]))
+        unsigned int lineSegments = 0;
+        for (unsigned int k = 0; k + 1 < n; ++k)
+        {
+          lineSegments += ids[k] != ids[k + 1] ? 1 : 0;
+        }
+        if (isPolygon ? distinct < 3 : lineSegments == 0)
         {
           itkExceptionMacro("Cell " << it.Index() << " is a " << (isPolygon ? "closed contour" : "contour") << " of "
                                     << (isPolygon ? distinct : 1)
                                     << " distinct point(s): an open contour needs at least 2 points, a closed one "
                                        "(polygon cell) at least 3.");
         }
-        const unsigned int segments = isPolygon ? n : 1;
+        const unsigned int segments = isPolygon ? n : n - 1;
         for (unsigned int k = 0; k < segments; ++k)
         {
           const auto a = ids[k];

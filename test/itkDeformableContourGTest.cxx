@@ -671,6 +671,58 @@ TEST(DeformableContour, OpenContourWithFixedOrFreeEnds)
   }
 }
 
+namespace
+{
+/** A cell of the line type with more than 2 points (a polyline), as ITK 5.2
+ * has none: the VTK bridge makes such cells. */
+class TestPolyLineCell : public PolygonType
+{
+public:
+  itk::CommonEnums::CellGeometry
+  GetType() const override
+  {
+    return itk::CommonEnums::CellGeometry::LINE_CELL;
+  }
+};
+} // namespace
+
+// One line cell of n points is the chain of its n - 1 segments: the open
+// contour of OpenContourWithFixedOrFreeEnds as one such cell gives the
+// contour of its 40 line cells, its two ends fixed.
+TEST(DeformableContour, LineCellOfSeveralPointsIsAChain)
+{
+  const EllipseCase c;
+  const auto        segments = MakeOpenContour(
+    Point(c.center[0] - 12.0, c.center[1] - 9.0), Point(c.center[0] + 12.0, c.center[1] - 9.0), 41, -3.0);
+  auto chain = MeshType::New();
+  chain->SetPoints(segments->GetPoints());
+  CellType::CellAutoPointer cell;
+  cell.TakeOwnership(new TestPolyLineCell);
+  for (unsigned int k = 0; k < 41; ++k)
+  {
+    cell->SetPointId(k, k);
+  }
+  chain->SetCell(0, cell);
+  MeshType::Pointer outputs[2];
+  const MeshType *  inputs[2] = { segments, chain };
+  for (unsigned int i = 0; i < 2; ++i)
+  {
+    auto filter = c.MakeFilter(inputs[i], 300);
+    filter->SetFixedBoundary(true);
+    filter->Update();
+    EXPECT_EQ(filter->GetNumberOfOpenContours(), 1u);
+    EXPECT_EQ(filter->GetNumberOfBoundaryVertices(), 2u);
+    outputs[i] = filter->GetOutput();
+    outputs[i]->DisconnectPipeline();
+  }
+  for (itk::IdentifierType k = 0; k < 41; ++k)
+  {
+    EXPECT_NEAR(outputs[1]->GetPoint(k)[0], outputs[0]->GetPoint(k)[0], 1e-9) << k;
+    EXPECT_NEAR(outputs[1]->GetPoint(k)[1], outputs[0]->GetPoint(k)[1], 1e-9) << k;
+  }
+  EXPECT_EQ(outputs[1]->GetPoint(40)[0], segments->GetPoint(40)[0]);
+}
+
 // The step bound and convergence on contours: a balloon of 1 mm bounded by
 // MaximumStepLength 0.25 moves a circle's points by 0.25 exactly; the
 // ellipse case with ConvergenceTolerance 0.002 pixel stops before its 1000

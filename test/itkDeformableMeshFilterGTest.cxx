@@ -29,6 +29,7 @@
 #include "edmTestUtilities.h"
 #include "gtest/gtest.h"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -446,9 +447,199 @@ TEST(DeformableMeshFilter, PrintsEveryParameter)
                                "MaximumStepLength: 0",
                                "ConvergenceTolerance: 0",
                                "ConvergenceWindow: 3",
+                               "ConvergenceFraction: 0",
+                               "DampOscillations: Off",
                                "Converged: false",
                                "OrientationSign: 1" })
   {
     EXPECT_NE(os.str().find(member), std::string::npos) << member;
+  }
+}
+
+namespace
+{
+/** A radial force of length 1 toward the sphere of radius \a radius about
+ * the origin: outward inside it, inward outside it, switching sign within
+ * one voxel of \a spacing mm. */
+VectorForceImageType::Pointer
+MakeShellForce(double radius, double spacing)
+{
+  const double                      extent = radius + 3.0;
+  VectorForceImageType::SizeType    size;
+  VectorForceImageType::SpacingType spacings;
+  VectorForceImageType::PointType   origin;
+  size.Fill(static_cast<itk::SizeValueType>(std::ceil(2.0 * extent / spacing)) + 1);
+  spacings.Fill(spacing);
+  origin.Fill(-extent);
+  return MakeForceImage<VectorForceImageType>(
+    size, spacings, origin, DirectionType::GetIdentity(), [radius](const VectorForceImageType::PointType & p) {
+      const double           r = p.GetVectorFromOrigin().GetNorm();
+      itk::Vector<double, 3> f;
+      f.Fill(0.0);
+      if (r > 0.0)
+      {
+        f = p.GetVectorFromOrigin() * ((r < radius ? 1.0 : -1.0) / r);
+      }
+      return f;
+    });
+}
+
+double
+LargestRadiusError(const MeshType * mesh, double radius)
+{
+  double largest = 0.0;
+  for (auto it = mesh->GetPoints()->Begin(); it != mesh->GetPoints()->End(); ++it)
+  {
+    largest = std::max(largest, std::abs(it.Value().GetVectorFromOrigin().GetNorm() - radius));
+  }
+  return largest;
+}
+} // namespace
+
+// A force that changes sign within a fifth of a step (a crest of the force
+// field, a thin gap): without damping the vertices jump across it for ever
+// and the largest displacement never falls below the tolerance; with
+// DampOscillations they settle on it.
+TEST(DeformableMeshFilter, DampOscillationsSettlesVerticesThatJumpAcrossASignChange)
+{
+  const double radius = 5.03;
+  const auto   force = MakeShellForce(radius, 0.1);
+  PointType    center;
+  center.Fill(0.0);
+  const auto sphere = itk::MakeSphereMesh<MeshType>(center, 4.0, 3);
+  using FilterType = itk::DeformableMeshFilter<MeshType, VectorForceImageType>;
+  for (const bool damp : { false, true })
+  {
+    auto filter = FilterType::New();
+    filter->SetInput(sphere);
+    filter->SetForceImage(force);
+    filter->SetScaleFactor(0.5);
+    filter->SetConvergenceTolerance(0.01);
+    filter->SetDampOscillations(damp);
+    filter->SetNumberOfIterations(300);
+    struct
+    {
+      itk::SizeValueType total{ 0 };
+    } damped;
+    filter->AddObserver(itk::IterationEvent(), [&](const itk::EventObject &) {
+      damped.total += filter->GetNumberOfDampedVertices();
+    });
+    filter->Update();
+    if (!damp)
+    {
+      // Reached the shell after 3 steps, then +-0.5 mm at every step.
+      EXPECT_FALSE(filter->GetConverged());
+      EXPECT_GT(filter->GetLastMaximumDisplacement(), 0.3);
+      EXPECT_EQ(damped.total, 0u);
+      EXPECT_GT(LargestRadiusError(filter->GetOutput(), radius), 0.2);
+    }
+    else
+    {
+      EXPECT_TRUE(filter->GetConverged());
+      EXPECT_LT(filter->GetCurrentIteration(), 60u);
+      EXPECT_GT(damped.total, sphere->GetNumberOfPoints());
+      // Settled within the voxel where the interpolated force changes sign.
+      EXPECT_LT(LargestRadiusError(filter->GetOutput(), radius), 0.1);
+    }
+  }
+}
+
+// A vertex that moves steadily (no reversal) keeps its whole step: with a
+// constant force the damped filter gives the undamped result bit for bit.
+TEST(DeformableMeshFilter, DampOscillationsLeavesSteadyMotionUnchanged)
+{
+  const auto force = MakeShellForce(9.0, 0.5);
+  PointType  center;
+  center.Fill(0.0);
+  const auto sphere = itk::MakeSphereMesh<MeshType>(center, 3.0, 3);
+  using FilterType = itk::DeformableMeshFilter<MeshType, VectorForceImageType>;
+  MeshType::Pointer outputs[2];
+  for (const bool damp : { false, true })
+  {
+    auto filter = FilterType::New();
+    filter->SetInput(sphere);
+    filter->SetForceImage(force);
+    filter->SetScaleFactor(0.25);
+    filter->SetElasticity(0.2);
+    filter->SetRigidity(0.05);
+    filter->SetDampOscillations(damp);
+    filter->SetNumberOfIterations(12);
+    filter->Update();
+    EXPECT_EQ(filter->GetNumberOfDampedVertices(), 0u);
+    outputs[damp] = filter->GetOutput();
+    outputs[damp]->DisconnectPipeline();
+  }
+  for (MeshType::PointIdentifier i = 0; i < sphere->GetNumberOfPoints(); ++i)
+  {
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      EXPECT_EQ(outputs[0]->GetPoint(i)[k], outputs[1]->GetPoint(i)[k]);
+    }
+  }
+}
+
+// ConvergenceFraction: the vertices of a cap (x > t on a sphere of radius
+// 3, t in the widest gap between the vertices' x near 2) are pushed along +x
+// for ever, the others feel no force (the force's linear ramp, one voxel of
+// 0.05 mm along x, holds no vertex). With the default (0) the filter never
+// converges; with a fraction above the cap's share it converges after
+// ConvergenceWindow iterations, and NumberOfActiveVertices is the cap's size.
+TEST(DeformableMeshFilter, ConvergenceFractionIgnoresAFewMovingVertices)
+{
+  PointType center;
+  center.Fill(0.0);
+  const auto          sphere = itk::MakeSphereMesh<MeshType>(center, 3.0, 3);
+  std::vector<double> xs;
+  for (auto it = sphere->GetPoints()->Begin(); it != sphere->GetPoints()->End(); ++it)
+  {
+    xs.push_back(it.Value()[0]);
+  }
+  std::sort(xs.begin(), xs.end());
+  double threshold = 0.0;
+  double widest = 0.0;
+  for (size_t i = 0; i + 1 < xs.size(); ++i)
+  {
+    if (xs[i] > 2.0 && xs[i + 1] < 2.9 && xs[i + 1] - xs[i] > widest)
+    {
+      widest = xs[i + 1] - xs[i];
+      threshold = 0.5 * (xs[i] + xs[i + 1]);
+    }
+  }
+  ASSERT_GT(widest, 0.12);
+  const auto cap = static_cast<itk::SizeValueType>(xs.end() - std::upper_bound(xs.begin(), xs.end(), threshold));
+  ASSERT_GT(cap, 0u);
+  ASSERT_LT(static_cast<double>(cap) / static_cast<double>(xs.size()), 0.2);
+
+  VectorForceImageType::SizeType size;
+  size[0] = 261;
+  size[1] = 17;
+  size[2] = 17;
+  VectorForceImageType::SpacingType spacing;
+  spacing[0] = 0.05;
+  spacing[1] = 0.5;
+  spacing[2] = 0.5;
+  VectorForceImageType::PointType origin;
+  origin.Fill(-4.0);
+  const auto force = MakeForceImage<VectorForceImageType>(
+    size, spacing, origin, DirectionType::GetIdentity(), [threshold](const VectorForceImageType::PointType & p) {
+      itk::Vector<double, 3> f;
+      f.Fill(0.0);
+      f[0] = p[0] >= threshold ? 1.0 : 0.0;
+      return f;
+    });
+  using FilterType = itk::DeformableMeshFilter<MeshType, VectorForceImageType>;
+  for (const double fraction : { 0.0, 0.2 })
+  {
+    auto filter = FilterType::New();
+    filter->SetInput(sphere);
+    filter->SetForceImage(force);
+    filter->SetScaleFactor(0.1);
+    filter->SetConvergenceTolerance(0.01);
+    filter->SetConvergenceFraction(fraction);
+    filter->SetNumberOfIterations(50);
+    filter->Update();
+    EXPECT_EQ(filter->GetConverged(), fraction > 0.0);
+    EXPECT_EQ(filter->GetCurrentIteration(), fraction > 0.0 ? 3u : 50u);
+    EXPECT_EQ(filter->GetNumberOfActiveVertices(), fraction > 0.0 ? cap : 0u);
   }
 }

@@ -44,6 +44,7 @@
 #include "vtkSmartPointer.h"
 #include "vtkTypeTraits.h"
 
+#include <cmath>
 #include <string>
 #include <type_traits>
 #include <unordered_map>
@@ -58,7 +59,10 @@
  *   points in one verts cell) becomes one VertexCell per point.
  * - Lines: a two-point cell <-> itk::LineCell; a longer polyline <->
  *   edm::PolyLineCell (a LINE_CELL with any number of points: ITK 5.2 has no
- *   polyline cell).
+ *   polyline cell), or, with MeshBridgeOptions::PolyLinesAsSegments, one
+ *   itk::LineCell per segment (the form the 2-D contours of
+ *   itk::DeformableMeshFilter take: a chain of segments, closed when it
+ *   comes back to its first point).
  * - Polys: a three-point cell <-> itk::TriangleCell; four points or more <->
  *   itk::PolygonCell. An itk::QuadrilateralCell becomes a four-point polygon
  *   (it comes back as an itk::PolygonCell with the same points).
@@ -100,6 +104,11 @@ namespace edm
  * exactly; the VTK algorithms of this module compute with it. */
 using PolyDataMeshType = itk::Mesh<double, 3, itk::DefaultStaticMeshTraits<double, 3, 3, double, double, double>>;
 
+/** The 2-D counterpart of PolyDataMeshType: contours (x, y) with double
+ * coordinates, as the VTK algorithms of this module compute them over a 2-D
+ * image (a vtkImageData of nx x ny x 1 points). */
+using ContourMeshType = itk::Mesh<double, 2, itk::DefaultStaticMeshTraits<double, 2, 2, double, double, double>>;
+
 /** Options of the mesh conversions. */
 struct MeshBridgeOptions
 {
@@ -112,6 +121,11 @@ struct MeshBridgeOptions
   bool PointData{ true };
   /** Convert cell data. Default: true. */
   bool CellData{ true };
+  /** VTK to ITK: each polyline of n points becomes n - 1 itk::LineCell
+   * (its segments, in order) instead of one edm::PolyLineCell. The ITK cell
+   * identifiers then no longer follow VTK's cells one for one, so cell data
+   * are not converted. Default: false. */
+  bool PolyLinesAsSegments{ false };
 };
 
 /** What a mesh conversion did. */
@@ -589,7 +603,15 @@ PolyDataToMesh(vtkPolyData *             polyData,
     result.SplitCells += n > 1 ? 1 : 0;
   });
   visit(polyData->GetLines(), [&](vtkIdType n) {
-    if (n == 2)
+    if (options.PolyLinesAsSegments)
+    {
+      for (vtkIdType k = 0; k + 1 < n; ++k)
+      {
+        addCell(new itk::LineCell<CellType>, &ids[k], &ids[k] + 2);
+      }
+      result.SplitCells += n > 2 ? 1 : 0;
+    }
+    else if (n == 2)
     {
       addCell(new itk::LineCell<CellType>, ids.data(), ids.data() + 2);
     }
@@ -627,7 +649,8 @@ PolyDataToMesh(vtkPolyData *             polyData,
       result.PointArrayName = array->GetName() != nullptr ? array->GetName() : "";
     }
   }
-  if (options.CellData && static_cast<vtkIdType>(cellId) == polyData->GetNumberOfCells() && cellId > 0)
+  if (options.CellData && !options.PolyLinesAsSegments &&
+      static_cast<vtkIdType>(cellId) == polyData->GetNumberOfCells() && cellId > 0)
   {
     if (vtkDataArray * array =
           detail::ChooseArray<typename TMesh::CellPixelType>(polyData->GetCellData(), options.CellArrayName))
@@ -700,8 +723,10 @@ ImageToImageData(const TImage * image, const std::string & arrayName = "ImageSca
 /** Copies a point array of a vtkImageData into a new itk::Image (dimension 3,
  * or lower when the image is flat along the last axes) with the same extent,
  * origin, spacing and direction. The array must have as many tuples as the
- * image has points and as many components as TImage's pixel. Throws
- * itk::ExceptionObject otherwise. */
+ * image has points and as many components as TImage's pixel. A 2-D image
+ * (nx x ny x 1) lies in a plane z = const: its direction matrix must not
+ * mix z with x and y (a plane of another orientation has no 2-D ITK
+ * counterpart). Throws itk::ExceptionObject otherwise. */
 template <typename TImage>
 typename TImage::Pointer
 ImageDataToImage(vtkImageData * imageData, vtkDataArray * array)
@@ -746,6 +771,19 @@ ImageDataToImage(vtkImageData * imageData, vtkDataArray * array)
   const double *                 vtkOrigin = imageData->GetOrigin();
   const double *                 vtkSpacing = imageData->GetSpacing();
   const vtkMatrix3x3 *           vtkDirection = imageData->GetDirectionMatrix();
+  for (unsigned int d = 0; d < 3; ++d)
+  {
+    for (unsigned int e = Dimension; e < 3; ++e)
+    {
+      if (d != e && (std::abs(vtkDirection->GetElement(static_cast<int>(d), static_cast<int>(e))) > 1e-9 ||
+                     std::abs(vtkDirection->GetElement(static_cast<int>(e), static_cast<int>(d))) > 1e-9))
+      {
+        itkGenericExceptionMacro("edm::ImageDataToImage: the direction matrix of the "
+                                 << Dimension << "-D vtkImageData mixes axis " << e
+                                 << " with the others: its plane is not z = const.");
+      }
+    }
+  }
   for (unsigned int d = 0; d < Dimension; ++d)
   {
     index[d] = extent[2 * d];

@@ -31,8 +31,10 @@ class vtkImageData;
  * after iteration, under a force field given as a vector image and internal
  * forces that keep the surface regular.
  *
- * The VTK face of itk::DeformableMeshFilter. Inputs:
- * - port 0: the initial mesh (vtkPolyData; triangles, polygons, strips, lines);
+ * The VTK face of itk::DeformableMeshFilter, in 3-D (surfaces) and in 2-D
+ * (contours, snakes). Inputs:
+ * - port 0: the initial mesh (vtkPolyData; triangles, polygons, strips, lines),
+ *   or, over a 2-D image, the initial contours (lines and polylines only);
  * - port 1: a vtkImageData holding the external force field as a
  *   three-component point array in physical space (origin, spacing and
  *   direction honoured), chosen with SetInputArrayToProcess(0, 1, 0,
@@ -42,13 +44,28 @@ class vtkImageData;
  *   with SetInputArrayToProcess(1, 1, 0, ...); by default the active scalars
  *   (vtkExternalForceField's output carries its input's scalars).
  *
+ * 2-D contours: when the image on port 1 is 2-D (a vtkImageData of nx x ny
+ * x 1 points; origin, spacing and the in-plane part of the direction matrix
+ * honoured) the input must be contours, lines and polylines, open or closed
+ * (a polyline is closed when it ends on the point it starts from), several
+ * per polydata; the 2-D itk::DeformableMeshFilter deforms them in the
+ * image's plane. The input's z is ignored; the output has the input's cells
+ * and its points in the image's plane (z of the image's points). The force
+ * array then has 3 components (the third is ignored; vtkExternalForceField
+ * gives 0) or 2. The balloon and the region force inflate closed contours
+ * (each is oriented counter-clockwise, whatever the order of its points), and
+ * need every contour closed: outward is undefined for an open one.
+ * FixedBoundary keeps the ends of open contours where they are. Everything
+ * else (parameters, diagnostics, the iteration contract) is as in 3-D;
+ * remeshing works on surfaces only.
+ *
  * The parameters and their defaults are the ITK filter's (the constructor
  * reads the defaults from it); itk::DeformableMeshFilter documents each one
  * in full, this header gives units, range and default.
  *
  * At each iteration every vertex x_i moves by
  *   s F(x_i) + a E_i + b R_i + beta n_i
- * with F the force field sampled by trilinear interpolation (ScaleFactor s),
+ * with F the force field sampled by trilinear (2-D: bilinear) interpolation (ScaleFactor s),
  * E_i the elastic force toward the centroid of the neighbours (Elasticity a),
  * R_i the rigidity (bending) force (Rigidity b) and n_i the outward normal
  * (Balloon beta). With all internal weights 0 (the defaults) each point moves
@@ -64,8 +81,13 @@ class vtkImageData;
  * they are zero before the first iteration.
  *
  * Errors (vtkErrorMacro and an empty output): no image on port 1, no array to
- * process, an array that does not have three components or does not match the
- * image's points, an empty mesh, an invalid parameter.
+ * process, an array that does not have three components (2-D: two or three)
+ * or does not match the image's points, an empty mesh, an invalid parameter;
+ * over a 2-D image: an input without lines, or with lines mixed with
+ * polygons, triangle strips or vertices, an image flat along x or y, a
+ * direction matrix that tilts the image's plane, the balloon or the region
+ * force with an open contour; over a 3-D image: lines alone in one plane
+ * z = const (a 2-D contour, which needs a 2-D image).
  *
  * @sa vtkIterativePolyDataAlgorithm itk::DeformableMeshFilter
  * itk::ExternalForceImageFilter
@@ -285,6 +307,21 @@ public:
 
   ///@{
   /**
+   * Keep the boundary of an open mesh at its input position, exactly: the
+   * ends of open contours (2-D), the boundary of open surfaces and the ends
+   * of lines (3-D). Off (default): they move like the other vertices, their
+   * internal forces from their neighbours on one side only (a free open
+   * contour shrinks along itself unless the image holds it). Closed contours
+   * and surfaces have no boundary.
+   * Meaning in full: itk::DeformableMeshFilter::SetFixedBoundary().
+   */
+  vtkSetMacro(FixedBoundary, vtkTypeBool);
+  vtkGetMacro(FixedBoundary, vtkTypeBool);
+  vtkBooleanMacro(FixedBoundary, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
    * Stop when the largest displacement stays below it for ConvergenceWindow
    * iterations; 0: never. Millimetres, at least 0; default 0.
    * Meaning in full: itk::DeformableMeshFilter::SetConvergenceTolerance().
@@ -301,6 +338,30 @@ public:
    */
   vtkSetClampMacro(ConvergenceWindow, int, 1, VTK_INT_MAX);
   vtkGetMacro(ConvergenceWindow, int);
+  ///@}
+
+  ///@{
+  /**
+   * With f > 0, an iteration is quiet when at most f x (number of points)
+   * vertices move by ConvergenceTolerance or more (0: when none does). In
+   * [0, 1]; default 0 (edmodel: 0.005).
+   * Meaning in full: itk::DeformableMeshFilter::SetConvergenceFraction().
+   */
+  vtkSetClampMacro(ConvergenceFraction, double, 0.0, 1.0);
+  vtkGetMacro(ConvergenceFraction, double);
+  ///@}
+
+  ///@{
+  /**
+   * Halve the step of a vertex whose displacement reverses its previous one
+   * (x1.25 back toward the full step otherwise), so that vertices jumping
+   * across a thin gap or a sharp crest of the force settle. Default off
+   * (edmodel: on).
+   * Meaning in full: itk::DeformableMeshFilter::SetDampOscillations().
+   */
+  vtkSetMacro(DampOscillations, vtkTypeBool);
+  vtkGetMacro(DampOscillations, vtkTypeBool);
+  vtkBooleanMacro(DampOscillations, vtkTypeBool);
   ///@}
 
   ///@{
@@ -323,12 +384,23 @@ public:
    */
   vtkGetMacro(LastMaximumDisplacement, double);
 
+  ///@{
+  /**
+   * 2-D: the closed and open contours found in the input at the last
+   * restart (0 in 3-D).
+   */
+  vtkGetMacro(NumberOfClosedContours, int);
+  vtkGetMacro(NumberOfOpenContours, int);
+  ///@}
+
 protected:
   vtkDeformableMesh();
   ~vtkDeformableMesh() override;
 
   int
   FillInputPortInformation(int port, vtkInformation * info) override;
+  int
+  RequestMeshDimension(vtkPolyData * input, vtkInformationVector ** inputVector) override;
   int
   PrepareFilter(vtkInformationVector ** inputVector) override;
   void
@@ -352,11 +424,16 @@ protected:
   vtkTypeBool EstimateObjectIntensityRange = 1;
   double      ObjectIntensityRange[2] = { 0.0, 1.0 };
   int         EdgePolarity = 0;
+  vtkTypeBool FixedBoundary = 0;
   double      ConvergenceTolerance = 0.0;
   int         ConvergenceWindow = 3;
+  double      ConvergenceFraction = 0.0;
+  vtkTypeBool DampOscillations = 0;
   vtkTypeBool ComputeDiagnostics = 1;
   vtkTypeBool Converged = 0;
   double      LastMaximumDisplacement = 0.0;
+  int         NumberOfClosedContours = 0;
+  int         NumberOfOpenContours = 0;
 
   // The typed ITK filter and the converted force image.
   vtkDeformableMeshInternals * DeformableInternals;

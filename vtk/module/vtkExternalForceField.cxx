@@ -27,6 +27,7 @@
 #include "vtkDataArray.h"
 #include "vtkDataObject.h"
 #include "vtkDataSetAttributes.h"
+#include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -36,14 +37,18 @@
 
 #include <cmath>
 #include <new>
+#include <type_traits>
 
 vtkStandardNewMacro(vtkExternalForceField);
 
 namespace
 {
-using IntensityImageType = itk::Image<float, 3>;
-using ForceImageType = itk::Image<itk::CovariantVector<float, 3>, 3>;
-using ForceFilterType = itk::ExternalForceImageFilter<IntensityImageType, ForceImageType>;
+template <unsigned int Dimension>
+using IntensityImageType = itk::Image<float, Dimension>;
+template <unsigned int Dimension>
+using ForceImageType = itk::Image<itk::CovariantVector<float, Dimension>, Dimension>;
+template <unsigned int Dimension>
+using ForceFilterType = itk::ExternalForceImageFilter<IntensityImageType<Dimension>, ForceImageType<Dimension>>;
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -99,9 +104,12 @@ vtkExternalForceField::RequestData(vtkInformation *,
   }
   int extent[6];
   input->GetExtent(extent);
-  if (extent[1] <= extent[0] || extent[3] <= extent[2] || extent[5] <= extent[4])
+  // 3-D, or 2-D in a plane z = const (nx x ny x 1 points).
+  const bool planar = extent[1] > extent[0] && extent[3] > extent[2] && extent[5] == extent[4];
+  if (!planar && (extent[1] <= extent[0] || extent[3] <= extent[2] || extent[5] <= extent[4]))
   {
-    vtkErrorMacro("The input image must be three-dimensional; its extent is ["
+    vtkErrorMacro("The input image must be three-dimensional, or two-dimensional with nx x ny x 1 points; its "
+                  "extent is ["
                   << extent[0] << ", " << extent[1] << "] x [" << extent[2] << ", " << extent[3] << "] x [" << extent[4]
                   << ", " << extent[5] << "].");
     return 0;
@@ -132,22 +140,55 @@ vtkExternalForceField::RequestData(vtkInformation *,
     return 0;
   }
 
-  vtkSmartPointer<vtkImageData> forces;
-  try
-  {
-    IntensityImageType::Pointer intensity = edm::ImageDataToImage<IntensityImageType>(input, array);
-    auto                        filter = ForceFilterType::New();
+  // Runs the ITK filter of the image's dimension; the force comes back as a
+  // three-component array (2-D: z component 0) on the input's points.
+  vtkSmartPointer<vtkDataArray> force;
+  auto                          run = [&](auto dimension) {
+    constexpr unsigned int Dimension = decltype(dimension)::value;
+    auto                   intensity = edm::ImageDataToImage<IntensityImageType<Dimension>>(input, array);
+    auto                   filter = ForceFilterType<Dimension>::New();
     filter->SetInput(intensity);
     filter->SetSigma(this->Sigma);
     filter->SetNormalizeForces(this->NormalizeForces != 0);
     filter->SetUseGradientVectorFlow(this->UseGradientVectorFlow != 0);
     filter->SetGradientVectorFlowRegularization(this->GradientVectorFlowRegularization);
     filter->SetGradientVectorFlowIterations(static_cast<unsigned int>(this->GradientVectorFlowIterations));
-    const ForceFilterType * observed = filter.GetPointer();
+    const auto * observed = filter.GetPointer();
     filter->AddObserver(itk::ProgressEvent(),
                         [this, observed](const itk::EventObject &) { this->UpdateProgress(observed->GetProgress()); });
     filter->Update();
-    forces = edm::ImageToImageData(filter->GetOutput(), "Force");
+    const auto *    field = filter->GetOutput();
+    const auto *    buffer = field->GetBufferPointer();
+    const vtkIdType numberOfPoints = input->GetNumberOfPoints();
+    if (static_cast<vtkIdType>(field->GetBufferedRegion().GetNumberOfPixels()) != numberOfPoints)
+    {
+      itkGenericExceptionMacro("the force image has " << field->GetBufferedRegion().GetNumberOfPixels()
+                                                      << " pixels, the input " << numberOfPoints << " points.");
+    }
+    auto values = vtkSmartPointer<vtkFloatArray>::New();
+    values->SetName("Force");
+    values->SetNumberOfComponents(3);
+    values->SetNumberOfTuples(numberOfPoints);
+    // ITK's and VTK's buffers both run x fastest: the i-th pixel is the i-th tuple.
+    for (vtkIdType i = 0; i < numberOfPoints; ++i)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        values->SetTypedComponent(i, c, c < static_cast<int>(Dimension) ? buffer[i][c] : 0.0f);
+      }
+    }
+    force = values;
+  };
+  try
+  {
+    if (planar)
+    {
+      run(std::integral_constant<unsigned int, 2>());
+    }
+    else
+    {
+      run(std::integral_constant<unsigned int, 3>());
+    }
   }
   catch (const itk::ExceptionObject & error)
   {
@@ -163,9 +204,8 @@ vtkExternalForceField::RequestData(vtkInformation *,
   }
 
   // The input's geometry and point arrays, plus the force as active vectors.
-  output->CopyStructure(forces);
+  output->CopyStructure(input);
   output->GetPointData()->PassData(input->GetPointData());
-  vtkDataArray * force = forces->GetPointData()->GetArray("Force");
   output->GetPointData()->AddArray(force);
   output->GetPointData()->SetActiveVectors("Force");
   return 1;

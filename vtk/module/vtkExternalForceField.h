@@ -37,12 +37,16 @@
  * given as it is to vtkDeformableMesh's port 1 and still be coloured by
  * intensity.
  *
- * The input must be a three-dimensional image (at least 4 points along each
- * axis for the Gaussian smoothing). The whole input extent is requested and
+ * The input is a three-dimensional image (at least 4 points along each axis
+ * for the Gaussian smoothing), or a two-dimensional one of nx x ny x 1 points
+ * (a plane z = const; the direction matrix must not mix z with x and y): the
+ * 2-D ITK filter then computes the in-plane force, and the "Force" array
+ * still has three components, the third 0, as vtkDeformableMesh and
+ * ParaView's glyphs expect. The whole input extent is requested and
  * the whole extent is produced.
  *
  * Errors (vtkErrorMacro and an empty output): no input array, an array with
- * more than one component, an image that is not three-dimensional, an invalid
+ * more than one component, an image that is neither 3-D nor nx x ny x 1, an invalid
  * parameter (a non-positive regularisation; SetSigma() clamps a negative
  * Sigma to 0), any exception of
  * the ITK filter (a Sigma beyond the image's largest extent, NaN or infinite

@@ -41,7 +41,9 @@ class vtkPolyData;
  *   written), each reached with one more step thanks to IterateFromZero off.
  *   When the algorithm stops early (convergence), the iteration it stopped at
  *   is the last one written. The algorithm's IterateFromZero and
- *   NumberOfIterations are restored afterwards.
+ *   NumberOfIterations are restored afterwards. A vtkDeformableMesh on 2-D
+ *   contours is driven the same way: each file holds the contours' lines in
+ *   the image's plane.
  * - WriteIteration() for each mesh produced elsewhere (for example an ITK
  *   filter observed at each iteration, its mesh converted with
  *   edm::MeshToPolyData), then WriteCollection().

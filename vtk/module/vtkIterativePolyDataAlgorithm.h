@@ -47,6 +47,12 @@ class vtkIterativePolyDataAlgorithmInternals;
  * point data type. Progress is forwarded from the ITK filter, and
  * SetAbortExecute(1) stops the iterations between two steps.
  *
+ * Two dimensions: a subclass with a 2-D ITK filter (vtkDeformableMesh)
+ * deforms contours, the lines and polylines of the input over a 2-D image,
+ * in the plane z = ContourPlaneZ (RequestMeshDimension() decides, at each
+ * update; the input's z is ignored and the output points have that z). The
+ * iteration contract is the same in both; a change of dimension restarts.
+ *
  * An empty input (no points) is an error: vtkErrorMacro and an empty output.
  * So is any exception thrown by the ITK filter.
  *
@@ -88,6 +94,13 @@ public:
   vtkBooleanMacro(IterateFromZero, vtkTypeBool);
   ///@}
 
+  /**
+   * Dimension of the model at the last update: 3 (surfaces, and curves in
+   * space) or 2 (contours in a plane z = const over a 2-D image); 0 before
+   * the first update or after an input was refused.
+   */
+  vtkGetMacro(MeshDimension, int);
+
 protected:
   vtkIterativePolyDataAlgorithm();
   ~vtkIterativePolyDataAlgorithm() override;
@@ -104,6 +117,16 @@ protected:
   PrepareFilter(vtkInformationVector ** inputVector) = 0;
 
   /**
+   * Subclass hook, called first at each update: the dimension of the model
+   * for this input, 3 (the default) or 2 (contours; set ContourPlaneZ, the z
+   * of the output points, and create Internals->ContourFilter). Return 0
+   * after a vtkErrorMacro to refuse the input (the output is then empty).
+   * MeshDimension holds the value for PrepareFilter() and AddOutputArrays().
+   */
+  virtual int
+  RequestMeshDimension(vtkPolyData * input, vtkInformationVector ** inputVector);
+
+  /**
    * Subclass hook, called after a successful update: add arrays (diagnostics)
    * to the output. Default: nothing.
    */
@@ -113,6 +136,8 @@ protected:
   int         NumberOfIterations = 0;
   int         CurrentIteration = 0;
   vtkTypeBool IterateFromZero = 1;
+  int         MeshDimension = 0;
+  double      ContourPlaneZ = 0.0;
 
   // The ITK filter, the cached ITK input mesh and what it was made from.
   vtkIterativePolyDataAlgorithmInternals * Internals;

@@ -39,19 +39,29 @@ edmProcessIsExiting();
 
 /**
  * The ITK side of a vtkIterativePolyDataAlgorithm (private header): the mesh
- * type the VTK classes compute with, the ITK filter of the subclass, and the
- * ITK mesh converted from the VTK input, kept while the input does not change
- * so that the ITK filter can continue its iterations.
+ * types the VTK classes compute with, the ITK filters of the subclass, and the
+ * ITK mesh converted from the VTK input, kept while the input (and the
+ * dimension of the model) does not change so that the ITK filter can continue
+ * its iterations.
+ *
+ * Two dimensions: surfaces (and curves) in 3-D go through Filter, contours
+ * over a 2-D image through ContourFilter, which only the subclasses that
+ * deform contours create. One of InputMesh and InputContourMesh is set at a
+ * time.
  */
 class vtkIterativePolyDataAlgorithmInternals
 {
 public:
-  using MeshType = edm::PolyDataMeshType; // double coordinates
+  using MeshType = edm::PolyDataMeshType;       // 3-D, double coordinates
+  using ContourMeshType = edm::ContourMeshType; // 2-D, double coordinates
   using FilterType = itk::IterativeMeshFilter<MeshType, MeshType>;
+  using ContourFilterType = itk::IterativeMeshFilter<ContourMeshType, ContourMeshType>;
 
-  FilterType::Pointer Filter;
-  MeshType::Pointer   InputMesh;
-  // Identity and modification time of the vtkPolyData InputMesh was made from.
+  FilterType::Pointer        Filter;
+  ContourFilterType::Pointer ContourFilter;
+  MeshType::Pointer          InputMesh;
+  ContourMeshType::Pointer   InputContourMesh;
+  // Identity and modification time of the vtkPolyData the cached mesh was made from.
   const vtkPolyData * InputPolyData = nullptr;
   vtkMTimeType        InputTime = 0;
 };

@@ -585,3 +585,98 @@ TEST(MeshBridge, ImageRoundTripKeepsGeometryAndPixels)
   scalars->SetNumberOfTuples(imageData->GetNumberOfPoints());
   EXPECT_THROW(edm::ImageDataToImage<ImageType>(imageData, scalars), itk::ExceptionObject);
 }
+
+// PolyLinesAsSegments: a polyline of n points becomes its n - 1 segments, in
+// order, each an itk::LineCell (the 2-D filter's contours); two-point lines
+// stay one segment; cell data, which no longer match cell for cell, are left
+// out. The 2-D mesh drops z.
+TEST(MeshBridge, PolyLinesAsSegmentsGivesOneLineCellPerSegment)
+{
+  vtkNew<vtkPolyData> polyData;
+  vtkNew<vtkPoints>   points;
+  for (int k = 0; k < 6; ++k)
+  {
+    points->InsertNextPoint(1.5 * k, -0.5 * k, 7.0);
+  }
+  vtkNew<vtkCellArray> lines;
+  const vtkIdType      closed[5] = { 0, 1, 2, 3, 0 };
+  const vtkIdType      segment[2] = { 4, 5 };
+  lines->InsertNextCell(5, closed);
+  lines->InsertNextCell(2, segment);
+  polyData->SetPoints(points);
+  polyData->SetLines(lines);
+  vtkNew<vtkIntArray> label;
+  label->SetName("Label");
+  label->InsertNextValue(10);
+  label->InsertNextValue(20);
+  polyData->GetCellData()->AddArray(label);
+
+  using ContourMeshType = itk::Mesh<int, 2, itk::DefaultStaticMeshTraits<int, 2, 2, double, double, int>>;
+  edm::MeshBridgeOptions options;
+  options.PolyLinesAsSegments = true;
+  edm::MeshBridgeReport report;
+  auto                  mesh = edm::PolyDataToMesh<ContourMeshType>(polyData, options, &report);
+  ASSERT_EQ(mesh->GetNumberOfCells(), 5u);
+  EXPECT_EQ(report.SplitCells, 1u);
+  EXPECT_EQ(report.CellArrayName, "");
+  const itk::IdentifierType expected[5][2] = { { 0, 1 }, { 1, 2 }, { 2, 3 }, { 3, 0 }, { 4, 5 } };
+  for (itk::IdentifierType c = 0; c < 5; ++c)
+  {
+    ContourMeshType::CellAutoPointer cell;
+    ASSERT_TRUE(mesh->GetCell(c, cell));
+    EXPECT_EQ(cell->GetType(), itk::CommonEnums::CellGeometry::LINE_CELL);
+    ASSERT_EQ(cell->GetNumberOfPoints(), 2u);
+    EXPECT_EQ(cell->PointIdsBegin()[0], expected[c][0]) << c;
+    EXPECT_EQ(cell->PointIdsBegin()[1], expected[c][1]) << c;
+  }
+  EXPECT_EQ(mesh->GetPoint(3)[0], 4.5);
+  EXPECT_EQ(mesh->GetPoint(3)[1], -1.5);
+
+  // Without the option: one polyline cell and the cell data.
+  auto whole = edm::PolyDataToMesh<ContourMeshType>(polyData);
+  EXPECT_EQ(whole->GetNumberOfCells(), 2u);
+  ASSERT_NE(whole->GetCellData(), nullptr);
+  EXPECT_EQ(whole->GetCellData()->ElementAt(1), 20);
+}
+
+// A 2-D vtkImageData becomes a 2-D itk::Image with its in-plane geometry; a
+// direction matrix that mixes z with x and y (a plane that is not z = const)
+// is refused.
+TEST(MeshBridge, PlanarImageKeepsItsPlaneOrIsRefused)
+{
+  using ImageType = itk::Image<float, 2>;
+  vtkNew<vtkImageData> imageData;
+  imageData->SetExtent(2, 5, -1, 1, 4, 4);
+  imageData->SetOrigin(1.0, 2.0, 3.0);
+  imageData->SetSpacing(0.5, 2.0, 9.0);
+  imageData->SetDirectionMatrix(0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0);
+  vtkNew<vtkFloatArray> values;
+  values->SetNumberOfTuples(imageData->GetNumberOfPoints());
+  for (vtkIdType i = 0; i < imageData->GetNumberOfPoints(); ++i)
+  {
+    values->SetValue(i, static_cast<float>(i));
+  }
+  auto image = edm::ImageDataToImage<ImageType>(imageData, values);
+  EXPECT_EQ(image->GetBufferedRegion().GetIndex()[0], 2);
+  EXPECT_EQ(image->GetBufferedRegion().GetIndex()[1], -1);
+  EXPECT_EQ(image->GetBufferedRegion().GetSize()[0], 4u);
+  EXPECT_EQ(image->GetBufferedRegion().GetSize()[1], 3u);
+  // Same in-plane position of every pixel in both libraries.
+  for (int j = -1; j <= 1; ++j)
+  {
+    for (int i = 2; i <= 5; ++i)
+    {
+      ImageType::IndexType index = { { i, j } };
+      ImageType::PointType itkPoint;
+      image->TransformIndexToPhysicalPoint(index, itkPoint);
+      double vtkPoint[3];
+      imageData->TransformIndexToPhysicalPoint(i, j, 4, vtkPoint);
+      EXPECT_DOUBLE_EQ(itkPoint[0], vtkPoint[0]);
+      EXPECT_DOUBLE_EQ(itkPoint[1], vtkPoint[1]);
+      int ijk[3] = { i, j, 4 };
+      EXPECT_EQ(image->GetPixel(index), values->GetValue(imageData->ComputePointId(ijk)));
+    }
+  }
+  imageData->SetDirectionMatrix(1.0, 0.0, 0.0, 0.0, 0.8, -0.6, 0.0, 0.6, 0.8);
+  EXPECT_THROW(edm::ImageDataToImage<ImageType>(imageData, values), itk::ExceptionObject);
+}

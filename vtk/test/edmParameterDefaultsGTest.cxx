@@ -246,6 +246,11 @@ TEST(ParameterDefaults, AgreeInTheITKAndVTKClassesThePluginAndTheCommandLine)
                 static_cast<double>(vtkModel->GetRemeshingInterval()),
                 nullptr,
                 nullptr },
+    { "FixedBoundary",
+                static_cast<double>(itkModel->GetFixedBoundary()),
+                static_cast<double>(vtkModel->GetFixedBoundary()),
+                nullptr,
+                nullptr },
     { "ConvergenceTolerance",
                 itkModel->GetConvergenceTolerance(),
                 vtkModel->GetConvergenceTolerance(),
@@ -256,6 +261,16 @@ TEST(ParameterDefaults, AgreeInTheITKAndVTKClassesThePluginAndTheCommandLine)
                 static_cast<double>(vtkModel->GetConvergenceWindow()),
                 "--window",
                 nullptr },
+    { "ConvergenceFraction",
+                itkModel->GetConvergenceFraction(),
+                vtkModel->GetConvergenceFraction(),
+                "--active-fraction",
+                "0.005" },
+    { "DampOscillations",
+                static_cast<double>(itkModel->GetDampOscillations()),
+                static_cast<double>(vtkModel->GetDampOscillations()),
+                "--no-damping",
+                "damping on" },
   };
   CheckLayers(model, sizeof(model) / sizeof(model[0]), "EDMDeformableMesh", xml, help);
 

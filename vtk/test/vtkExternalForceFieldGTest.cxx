@@ -326,9 +326,9 @@ TEST(VTKExternalForceField, WrongInputsGiveAnErrorAndAnEmptyOutput)
   EXPECT_TRUE(errors.Contains("No intensity array")) << errors.Text();
   EXPECT_EQ(forces->GetOutput()->GetNumberOfPoints(), 0);
 
-  // A two-dimensional image.
+  // An image flat along y (a 2-D image is flat along z: nx x ny x 1).
   vtkNew<vtkImageData> slice;
-  slice->SetDimensions(8, 8, 1);
+  slice->SetDimensions(8, 1, 8);
   slice->AllocateScalars(VTK_FLOAT, 1);
   slice->GetPointData()->GetScalars()->Fill(0.0);
   forces->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);

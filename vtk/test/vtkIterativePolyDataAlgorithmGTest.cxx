@@ -798,8 +798,12 @@ TEST(VTKIterativeAlgorithms, PrintSelfPrintsEveryParameter)
                              "MaximumStepLength",
                              "RemeshingEdgeLength",
                              "RemeshingInterval",
+                             "FixedBoundary",
                              "ConvergenceTolerance",
                              "ConvergenceWindow",
+                             "MeshDimension",
+                             "NumberOfClosedContours",
+                             "NumberOfOpenContours",
                              "ComputeDiagnostics",
                              "Converged",
                              "LastMaximumDisplacement" })

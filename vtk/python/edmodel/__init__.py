@@ -3,8 +3,10 @@ ExplicitDeformableModel.
 
 Classes:
   vtkPolyDataIterativeWarp   Brownian random walk of the points (StepLength, Seed)
-  vtkDeformableMesh          deformable surface pulled by a vector image (port 1)
-  vtkExternalForceField      the force image of a volume (grad |grad G_sigma * I|, GVF)
+  vtkDeformableMesh          deformable surface pulled by a vector image (port 1), or
+                             contours (lines, polylines) over a 2-D image (nx x ny x 1)
+  vtkExternalForceField      the force image of a volume or a 2-D image
+                             (grad |grad G_sigma * I|, GVF)
   vtkIterationSeriesWriter   every K-th iteration as .vtp plus a .pvd collection
   vtkIterativePolyDataAlgorithm  their base class (NumberOfIterations,
                              CurrentIteration, IterateFromZero)
