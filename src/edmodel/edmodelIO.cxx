@@ -1845,6 +1845,12 @@ UnregisterTemporaryDirectory(int id)
   UnregisterCleanup(id);
 }
 
+std::unique_lock<std::mutex>
+LockTemporaryOutputs()
+{
+  return std::unique_lock<std::mutex>(g_CleanupMutex);
+}
+
 std::string
 OneLine(const std::string & text)
 {

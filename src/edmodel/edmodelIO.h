@@ -8,6 +8,7 @@
 #include "itkImage.h"
 #include "itkMesh.h"
 
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -111,6 +112,12 @@ int
 RegisterTemporaryDirectory(const std::string & path, bool recursive);
 void
 UnregisterTemporaryDirectory(int id);
+/** Held while files are written into a temporary directory registered for
+ * cleanup: the signal thread takes it before it removes the temporary
+ * outputs (and keeps it), so that no file appears in a directory it is
+ * removing. */
+std::unique_lock<std::mutex>
+LockTemporaryOutputs();
 
 /** Writes \a data to \a path, checking every write and the close (a full
  * disk is an Error). */

@@ -160,6 +160,9 @@ SnapshotSeries::Add(const MeshType * mesh, itk::SizeValueType iteration)
   options.PointData = false;
   options.CellData = false;
   vtkSmartPointer<vtkPolyData> polyData = edm::MeshToPolyData(mesh, options);
+  // A signal that ends the run while the file is written removes the
+  // series' temporary directory after it, not during it.
+  const auto lock = LockTemporaryOutputs();
   if (m_Internals->writer->WriteIteration(polyData, static_cast<int>(iteration)) != 1)
   {
     throw Error("--snapshots: cannot write the mesh of iteration " + std::to_string(iteration) + " in '" +

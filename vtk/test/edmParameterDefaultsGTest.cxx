@@ -191,7 +191,7 @@ TEST(ParameterDefaults, AgreeInTheITKAndVTKClassesThePluginAndTheCommandLine)
                 static_cast<double>(itkModel->GetTangentialElasticity()),
                 static_cast<double>(vtkModel->GetTangentialElasticity()),
                 "--no-tangential-elasticity",
-                "full umbrella" },
+                "full umbrella on 3-D surfaces, tangential on 2-D contours" },
     { "Rigidity", itkModel->GetRigidity(), vtkModel->GetRigidity(), "--rigidity", "0.05" },
     { "RegionWeight",
                 itkModel->GetRegionWeight(),
