@@ -854,10 +854,10 @@ private:
   SizeValueType            m_NumberOfDampedVertices{ 0 };
   /** Per vertex: the previous displacement (x, y, z) and the step factor. */
   std::vector<std::array<float, 4>> m_OscillationState;
-  double                   m_MinimumDistance{ 0.0 };
-  SizeValueType            m_NumberOfCollisionsPrevented{ 0 };
-  SizeValueType            m_TotalNumberOfCollisionsPrevented{ 0 };
-  SizeValueType            m_NumberOfConstrainedVertices{ 0 };
+  double                            m_MinimumDistance{ 0.0 };
+  SizeValueType                     m_NumberOfCollisionsPrevented{ 0 };
+  SizeValueType                     m_TotalNumberOfCollisionsPrevented{ 0 };
+  SizeValueType                     m_NumberOfConstrainedVertices{ 0 };
   /** The collision test's tables and index (PreventSelfIntersections). */
   SurfaceCollision m_Collision;
   /** The triangles last given to ResetCollision() (empty: the input's). */

@@ -1071,8 +1071,8 @@ DeformableMeshFilter<TMesh, TForceImage>::ConstrainSelfIntersections(std::vector
 template <typename TMesh, typename TForceImage>
 void
 DeformableMeshFilter<TMesh, TForceImage>::FinishStep(const double *        start,
-                                                                 std::vector<double> & blockMaximum,
-                                                                 bool                  diagnose)
+                                                     std::vector<double> & blockMaximum,
+                                                     bool                  diagnose)
 {
   using namespace DeformableMeshFilterDetail;
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
@@ -1108,11 +1108,10 @@ DeformableMeshFilter<TMesh, TForceImage>::FinishStep(const double *        start
         }
         std::array<float, 4> & state = m_OscillationState[i];
         double                 d[3] = { next[3 * i] - start[3 * i],
-                        next[3 * i + 1] - start[3 * i + 1],
-                        next[3 * i + 2] - start[3 * i + 2] };
+                                        next[3 * i + 1] - start[3 * i + 1],
+                                        next[3 * i + 2] - start[3 * i + 2] };
         const double           dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-        const double           pp = double{ state[0] } * state[0] + double{ state[1] } * state[1] +
-                          double{ state[2] } * state[2];
+        const double pp = double{ state[0] } * state[0] + double{ state[1] } * state[1] + double{ state[2] } * state[2];
         const double dp = d[0] * state[0] + d[1] * state[1] + d[2] * state[2];
         // Reversal: the angle between the two displacements above 120 degrees.
         if (dp < 0.0 && 4.0 * dp * dp > dd * pp)
@@ -1416,10 +1415,9 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   // Quiet: the largest displacement below the tolerance, or with
   // ConvergenceFraction > 0, at most that fraction of the vertices moving by
   // the tolerance or more.
-  const bool quiet =
-    m_ConvergenceFraction > 0.0
-      ? static_cast<double>(m_NumberOfActiveVertices) <= m_ConvergenceFraction * static_cast<double>(numberOfPoints)
-      : m_LastMaximumDisplacement < m_ConvergenceTolerance;
+  const bool quiet = m_ConvergenceFraction > 0.0 ? static_cast<double>(m_NumberOfActiveVertices) <=
+                                                     m_ConvergenceFraction * static_cast<double>(numberOfPoints)
+                                                 : m_LastMaximumDisplacement < m_ConvergenceTolerance;
   if (m_ConvergenceTolerance > 0.0 && quiet)
   {
     m_Converged = ++m_QuietIterations >= m_ConvergenceWindow;

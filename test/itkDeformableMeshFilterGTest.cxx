@@ -521,9 +521,8 @@ TEST(DeformableMeshFilter, DampOscillationsSettlesVerticesThatJumpAcrossASignCha
     {
       itk::SizeValueType total{ 0 };
     } damped;
-    filter->AddObserver(itk::IterationEvent(), [&](const itk::EventObject &) {
-      damped.total += filter->GetNumberOfDampedVertices();
-    });
+    filter->AddObserver(itk::IterationEvent(),
+                        [&](const itk::EventObject &) { damped.total += filter->GetNumberOfDampedVertices(); });
     filter->Update();
     if (!damp)
     {

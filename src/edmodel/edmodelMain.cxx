@@ -514,7 +514,8 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                 "--iterations",
                 "N",
                 "largest number of iterations of each resolution level; the first of several (the capture level) runs "
-                "up to " + std::to_string(defaults::CaptureIterations) + " when this is lower (0 writes the initial mesh)",
+                "up to " +
+                  std::to_string(defaults::CaptureIterations) + " when this is lower (0 writes the initial mesh)",
                 std::to_string(defaults::Iterations),
                 [&o](const std::string & s) { o.iterations = ParseUnsigned("--iterations", s); } });
   t.push_back({ model,

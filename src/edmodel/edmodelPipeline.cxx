@@ -566,20 +566,19 @@ Deform(const ImageType *        image,
     result.converged = deform->GetConverged();
     result.lastMaximumDisplacement = deform->GetLastMaximumDisplacement();
     const double deformSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - deformStart).count();
-    progress.Finish(std::to_string(deform->GetCurrentIteration()) + " iterations on " + level + ", " +
-                    (result.converged
-                       ? "converged (" +
-                           (o.convergenceFraction > 0.0
-                              ? "at most " +
-                                  std::to_string(static_cast<unsigned long long>(
-                                    o.convergenceFraction * static_cast<double>(stageInput->GetNumberOfPoints()))) +
-                                  " vertices moving by "
-                              : std::string("largest step below ")) +
-                           Format(deform->GetConvergenceTolerance()) + " mm for " +
-                           std::to_string(o.convergenceWindow) + " iterations)"
-                       : std::string("iteration cap reached")) +
-                    ", last largest step " + Format(result.lastMaximumDisplacement) + " mm (" +
-                    Format(deformSeconds, 2) + " s)");
+    progress.Finish(
+      std::to_string(deform->GetCurrentIteration()) + " iterations on " + level + ", " +
+      (result.converged ? "converged (" +
+                            (o.convergenceFraction > 0.0
+                               ? "at most " +
+                                   std::to_string(static_cast<unsigned long long>(
+                                     o.convergenceFraction * static_cast<double>(stageInput->GetNumberOfPoints()))) +
+                                   " vertices moving by "
+                               : std::string("largest step below ")) +
+                            Format(deform->GetConvergenceTolerance()) + " mm for " +
+                            std::to_string(o.convergenceWindow) + " iterations)"
+                        : std::string("iteration cap reached")) +
+      ", last largest step " + Format(result.lastMaximumDisplacement) + " mm (" + Format(deformSeconds, 2) + " s)");
     MeshType::Pointer output = deform->GetOutput();
     output->DisconnectPipeline();
     last = last || !(MeanEdgeLength(output) > 1.5 * edgeLength) ||
