@@ -25,6 +25,7 @@
 #include "edmodelIO.h"
 #include "edmodelOptions.h"
 #include "edmodelProgress.h"
+#include "edmodelSchedule.h"
 
 #include "itkDeformableMeshFilter.h"
 #include "itkExternalForceImageFilter.h"
@@ -76,14 +77,6 @@ struct Contour
 using Contours = std::vector<Contour>;
 
 std::string
-Format(double value, int precision = 3)
-{
-  std::ostringstream stream;
-  stream << std::setprecision(precision) << value;
-  return stream.str();
-}
-
-std::string
 Quote(const std::string & path)
 {
   return "'" + path + "'";
@@ -96,59 +89,6 @@ MakePoint(double x, double y)
   p[0] = x;
   p[1] = y;
   return p;
-}
-
-// --- The image's frame ------------------------------------------------------
-
-double
-SmallestSpacing(const Image2DType * image)
-{
-  return std::min(image->GetSpacing()[0], image->GetSpacing()[1]);
-}
-
-/** True when p falls within the image's pixels (half a pixel beyond the
- * first and last pixel centres), widened by margin pixels on each side. */
-bool
-IsInsideImage(const Image2DType * image, const Point2 & p, double margin = 0.0)
-{
-  itk::ContinuousIndex<double, 2> index;
-  static_cast<void>(image->TransformPhysicalPointToContinuousIndex(p, index)); // the region test follows
-  const auto & region = image->GetLargestPossibleRegion();
-  for (unsigned int k = 0; k < 2; ++k)
-  {
-    const double low = static_cast<double>(region.GetIndex()[k]) - 0.5 - margin;
-    if (!(index[k] >= low && index[k] <= low + static_cast<double>(region.GetSize()[k]) + 2.0 * margin))
-    {
-      return false;
-    }
-  }
-  return true;
-}
-
-/** The physical bounding box of the image's pixels, for messages. */
-std::string
-DescribeBounds(const Image2DType * image)
-{
-  double     low[2] = { 1e300, 1e300 };
-  double     high[2] = { -1e300, -1e300 };
-  const auto region = image->GetLargestPossibleRegion();
-  for (unsigned int corner = 0; corner < 4; ++corner)
-  {
-    itk::ContinuousIndex<double, 2> index;
-    for (unsigned int k = 0; k < 2; ++k)
-    {
-      index[k] = region.GetIndex()[k] - 0.5 + ((corner >> k) & 1 ? region.GetSize()[k] : 0);
-    }
-    Point2 p;
-    image->TransformContinuousIndexToPhysicalPoint(index, p);
-    for (unsigned int k = 0; k < 2; ++k)
-    {
-      low[k] = std::min(low[k], p[k]);
-      high[k] = std::max(high[k], p[k]);
-    }
-  }
-  return "x " + Format(low[0], 6) + " to " + Format(high[0], 6) + ", y " + Format(low[1], 6) + " to " +
-         Format(high[1], 6) + " mm";
 }
 
 // --- Contours ---------------------------------------------------------------
@@ -987,45 +927,27 @@ DeformContours(const Image2DType *     image,
 {
   ContourResult result;
   const double  smallest = SmallestSpacing(image);
-  const double  sigma = o.sigma >= 0.0 ? o.sigma : defaults::SigmaInVoxels * smallest;
-  const double  scale = o.scale >= 0.0 ? o.scale : defaults::ScaleOverSigma * (sigma > 0.0 ? sigma : smallest);
-
-  auto force = Force2DFilterType::New();
-  force->SetInput(image);
-  force->SetSigma(sigma);
-  force->SetNormalizeForces(o.normalizeForces);
-  force->SetUseGradientVectorFlow(o.gradientVectorFlow);
-  force->SetGradientVectorFlowRegularization(o.gradientVectorFlowRegularization);
-  force->SetGradientVectorFlowIterations(o.gradientVectorFlowIterations);
-  progress.Start("force field");
-  force->AddObserver(itk::ProgressEvent(),
-                     [&](const itk::EventObject &) { progress.Update(force->GetProgress(), ""); });
-  const auto start = std::chrono::steady_clock::now();
-  try
-  {
-    force->Update();
-  }
-  catch (const itk::ExceptionObject & exception)
-  {
-    throw Error("force field: " + OneLine(exception.GetDescription()));
-  }
-  result.force = force->GetOutput();
-  progress.Finish("sigma " + Format(sigma) + " mm" + (o.gradientVectorFlow ? ", gradient vector flow" : "") +
-                  (o.normalizeForces ? ", normalised" : ", not normalised") + " (" +
-                  Format(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2) + " s)");
+  const double  scale = ForceScale(image, o);
+  result.force = ComputeForceField<Force2DFilterType>(image, o, progress);
 
   // Outward is undefined on an open contour: no region force there.
-  const bool   open = HasOpenContour(initial);
-  const double regionWeight = open                    ? 0.0
-                              : o.regionWeight >= 0.0 ? o.regionWeight
-                                                      : defaults::RegionWeightInVoxels * smallest;
-  const double regionSigma = o.regionSigma >= 0.0 ? o.regionSigma : defaults::RegionSigmaInVoxels * smallest;
-  const double edgeSearchWeight = open                        ? 0.0
-                                  : o.edgeSearchWeight >= 0.0 ? o.edgeSearchWeight
-                                                              : defaults::EdgeSearchWeightInVoxels * smallest;
-  const double edgeSearchDistance =
+  const bool    open = HasOpenContour(initial);
+  LevelSchedule schedule;
+  schedule.scale = scale;
+  schedule.regionWeight = open                    ? 0.0
+                          : o.regionWeight >= 0.0 ? o.regionWeight
+                                                  : defaults::RegionWeightInVoxels * smallest;
+  schedule.regionSigma = o.regionSigma >= 0.0 ? o.regionSigma : defaults::RegionSigmaInVoxels * smallest;
+  schedule.edgeSearchWeight = open                        ? 0.0
+                              : o.edgeSearchWeight >= 0.0 ? o.edgeSearchWeight
+                                                          : defaults::EdgeSearchWeightInVoxels * smallest;
+  schedule.edgeSearchDistance =
     o.edgeSearchDistance > 0.0 ? o.edgeSearchDistance : defaults::EdgeSearchDistanceInVoxels * smallest;
-  const double edgeLength = o.edgeLength > 0.0 ? o.edgeLength : defaults::EdgeLengthInVoxels * smallest;
+  schedule.edgeLength = o.edgeLength > 0.0 ? o.edgeLength : defaults::EdgeLengthInVoxels * smallest;
+  schedule.tangentialElasticity =
+    o.tangentialElasticityGiven ? o.tangentialElasticity : defaults::ContourTangentialElasticity;
+  schedule.pointsWord = "points";
+  schedule.initialWhat = "contour";
   if (open && o.regionWeight < 0.0)
   {
     progress.Note("open contour: no region force (outward is undefined); gradient forces only");
@@ -1035,13 +957,11 @@ DeformContours(const Image2DType *     image,
   // perimeter long: refining beyond 4 times that many edges of
   // --edge-length means it has left the image or tangled (checked after the
   // run); the levels stop there.
-  const auto         imageSize = image->GetLargestPossibleRegion().GetSize();
-  const double       perimeter = 2.0 * (imageSize[0] * image->GetSpacing()[0] + imageSize[1] * image->GetSpacing()[1]);
-  const double       maximumPoints = std::min<double>(defaults::MaximumRefinedPoints, 4.0 * perimeter / edgeLength);
-  Contours           stageInput = initial;
-  bool               haveModel = false;
-  double             model[2] = { 0.0, 0.0 };
-  itk::SizeValueType iterationsBefore = 0;
+  const auto   imageSize = image->GetLargestPossibleRegion().GetSize();
+  const double perimeter = 2.0 * (imageSize[0] * image->GetSpacing()[0] + imageSize[1] * image->GetSpacing()[1]);
+  const double maximumPoints = std::min<double>(defaults::MaximumRefinedPoints, 4.0 * perimeter / schedule.edgeLength);
+  Contours     stageInput = initial;
+  LevelState   state;
   if (snapshot)
   {
     snapshot(initial, 0);
@@ -1052,113 +972,28 @@ DeformContours(const Image2DType *     image,
     // --edge-length (a small circle inside the object): the first level is
     // then a capture level anyway, and a last level at the same resolution
     // follows it.
-    bool last = regionWeight == 0.0;
-    auto deform = ContourFilterType::New();
+    const bool last = schedule.regionWeight == 0.0;
+    auto       deform = ContourFilterType::New();
     deform->SetInput(ToMesh(stageInput));
     deform->SetForceImage(result.force);
-    deform->SetScaleFactor(scale);
-    // As in 3-D: the capture level (the first of several) keeps the default
-    // internal weights, --elasticity and --rigidity shape the refined ones.
-    const bool capture = stage == 0 && !last;
-    deform->SetElasticity(capture ? defaults::Elasticity : o.elasticity);
-    deform->SetTangentialElasticity(o.tangentialElasticityGiven ? o.tangentialElasticity
-                                                                : defaults::ContourTangentialElasticity);
-    deform->SetRigidity(capture ? defaults::Rigidity : o.rigidity);
-    deform->SetBalloon(o.balloon);
     deform->SetIntensityImage(image);
-    // Refined levels finer than FineLevelEdgeLengths x --edge-length weight
-    // the region force by (h / that length)^2, as in 3-D: the membrane force
-    // of a contour of edge h bends it by about a h^2 kappa / 2 per iteration.
-    const double levelEdge = MeanEdgeLength(stageInput) / (defaults::FineLevelEdgeLengths * edgeLength);
-    deform->SetRegionWeight(stage == 0 ? regionWeight : regionWeight * std::min(1.0, levelEdge * levelEdge));
-    deform->SetRegionSigma(stage == 0 && !last ? defaults::CoarseRegionSigmaFactor * regionSigma : regionSigma);
-    deform->SetIntensityTolerance(o.intensityTolerance);
-    deform->SetEdgeSearchWeight(edgeSearchWeight);
-    deform->SetEdgeSearchDistance(edgeSearchDistance);
-    if (o.hasObjectRange)
-    {
-      deform->SetObjectIntensityRange(o.objectRange[0], o.objectRange[1], 0.1 * (o.objectRange[1] - o.objectRange[0]));
-    }
-    else if (haveModel)
-    {
-      deform->SetObjectIntensityStatistics(model[0], model[1]);
-    }
-    deform->SetFixedBoundary(o.fixedBoundary);
-    deform->SetDampOscillations(o.dampOscillations);
-    deform->SetMaximumStepLength(o.maximumStepLength);
-    deform->SetConvergenceTolerance(o.convergenceTolerance);
-    deform->SetConvergenceWindow(o.convergenceWindow);
-    deform->SetConvergenceFraction(o.convergenceFraction);
-    // As in 3-D, the capture level runs until it converges, up to
-    // CaptureIterations (or --iterations when larger).
-    deform->SetNumberOfIterations(capture && o.iterations > 0 ? std::max(o.iterations, defaults::CaptureIterations)
-                                                              : o.iterations);
-    const std::string level = std::to_string(CountPoints(stageInput)) + " points";
-    progress.Start("deforming");
-    const auto deformStart = std::chrono::steady_clock::now();
-    deform->AddObserver(itk::ProgressEvent(), [&](const itk::EventObject &) {
-      const auto total = deform->GetNumberOfIterations();
-      const auto current = deform->GetCurrentIteration();
-      progress.Update(total > 0 ? static_cast<double>(current) / total : 1.0,
-                      level + ", iteration " + std::to_string(current) + "/" + std::to_string(total) +
-                        ", largest step " + Format(deform->GetLastMaximumDisplacement()) + " mm");
-    });
-    if (snapshot)
-    {
-      deform->AddObserver(itk::IterationEvent(), [&](const itk::EventObject &) {
-        if (deform->GetCurrentIteration() % o.snapshotEvery == 0)
-        {
-          snapshot(FromMesh(deform->GetOutput(), stageInput), iterationsBefore + deform->GetCurrentIteration());
-        }
-      });
-    }
-    try
-    {
-      deform->Update();
-    }
-    catch (const itk::ExceptionObject & exception)
-    {
-      throw Error("deformation: " + OneLine(exception.GetDescription()));
-    }
-    if (deform->GetRegionWeight() > 0.0 && !o.hasObjectRange && !haveModel)
-    {
-      haveModel = true;
-      model[0] = deform->GetObjectIntensityMedian();
-      model[1] = deform->GetObjectIntensitySpread();
-      progress.Note("region force: object intensity median " + Format(model[0], 4) + ", spread " + Format(model[1], 3) +
-                    " (estimated inside the initial contour)");
-    }
-    if (deform->GetRegionWeight() > 0.0)
-    {
-      progress.Note("region force: intensity range [" + Format(deform->GetObjectIntensityLower(), 4) + ", " +
-                    Format(deform->GetObjectIntensityUpper(), 4) + "], transition width " +
-                    Format(deform->GetObjectIntensityWidth(), 3));
-    }
+    ConfigureLevel(deform.GetPointer(), o, schedule, state, stage, last, MeanEdgeLength(stageInput));
+    RunLevel(deform.GetPointer(),
+             o,
+             schedule,
+             progress,
+             CountPoints(stageInput),
+             state,
+             snapshot ? std::function<void(itk::SizeValueType)>([&](itk::SizeValueType iteration) {
+               snapshot(FromMesh(deform->GetOutput(), stageInput), iteration);
+             })
+                      : std::function<void(itk::SizeValueType)>());
+    result.iterations = state.iterations;
+    result.converged = state.converged;
+    result.lastMaximumDisplacement = state.lastMaximumDisplacement;
     const Contours output = FromMesh(deform->GetOutput(), stageInput);
-    if (snapshot && deform->GetCurrentIteration() % o.snapshotEvery != 0)
-    {
-      snapshot(output, iterationsBefore + deform->GetCurrentIteration());
-    }
-    result.iterations += deform->GetCurrentIteration();
-    iterationsBefore = result.iterations;
-    result.converged = deform->GetConverged();
-    result.lastMaximumDisplacement = deform->GetLastMaximumDisplacement();
-    const double deformSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - deformStart).count();
-    progress.Finish(
-      std::to_string(deform->GetCurrentIteration()) + " iterations on " + level + ", " +
-      (result.converged
-         ? "converged (" +
-             (o.convergenceFraction > 0.0 ? "at most " +
-                                              std::to_string(static_cast<unsigned long long>(
-                                                o.convergenceFraction * static_cast<double>(CountPoints(stageInput)))) +
-                                              " points moving by "
-                                          : std::string("largest step below ")) +
-             Format(deform->GetConvergenceTolerance()) + " mm for " + std::to_string(o.convergenceWindow) +
-             " iterations)"
-         : std::string("iteration cap reached")) +
-      ", last largest step " + Format(result.lastMaximumDisplacement) + " mm (" + Format(deformSeconds, 2) + " s)");
-    const bool fine =
-      !(MeanEdgeLength(output) > 1.5 * edgeLength) || 2.0 * static_cast<double>(CountPoints(output)) > maximumPoints;
+    const bool     fine = !(MeanEdgeLength(output) > 1.5 * schedule.edgeLength) ||
+                      2.0 * static_cast<double>(CountPoints(output)) > maximumPoints;
     if (last || (stage > 0 && fine))
     {
       result.contours = output;

@@ -7,6 +7,7 @@
 #include "edmodelIO.h"
 #include "edmodelOptions.h"
 #include "edmodelProgress.h"
+#include "edmodelSchedule.h"
 
 #include "itkDeformableMeshFilter.h"
 #include "itkEllipsoidPhantom.h"
@@ -36,14 +37,6 @@ using ForceFilterType = itk::ExternalForceImageFilter<ImageType, ForceImageType>
 using DeformFilterType = itk::DeformableMeshFilter<MeshType, ForceImageType>;
 
 std::string
-Format(double value, int precision = 3)
-{
-  std::ostringstream stream;
-  stream << std::setprecision(precision) << value;
-  return stream.str();
-}
-
-std::string
 FormatPoint(const double * p, unsigned int n)
 {
   std::string text = "(";
@@ -52,59 +45,6 @@ FormatPoint(const double * p, unsigned int n)
     text += (k == 0 ? "" : ", ") + Format(p[k], 6);
   }
   return text + ")";
-}
-
-double
-SmallestSpacing(const ImageType * image)
-{
-  const auto & spacing = image->GetSpacing();
-  return std::min({ spacing[0], spacing[1], spacing[2] });
-}
-
-/** True when p falls within the image's voxels (half a voxel beyond the first
- * and last voxel centres, the domain where the force is sampled), widened by
- * margin voxels on each side. */
-bool
-IsInsideImage(const ImageType * image, const MeshType::PointType & p, double margin = 0.0)
-{
-  itk::ContinuousIndex<double, 3> index;
-  static_cast<void>(image->TransformPhysicalPointToContinuousIndex(p, index)); // the region test follows
-  const auto & region = image->GetLargestPossibleRegion();
-  for (unsigned int k = 0; k < 3; ++k)
-  {
-    const double low = static_cast<double>(region.GetIndex()[k]) - 0.5 - margin;
-    if (!(index[k] >= low && index[k] <= low + static_cast<double>(region.GetSize()[k]) + 2.0 * margin))
-    {
-      return false;
-    }
-  }
-  return true;
-}
-
-/** The physical bounding box of the image's voxels, for messages. */
-std::string
-DescribeBounds(const ImageType * image)
-{
-  double     low[3] = { 1e300, 1e300, 1e300 };
-  double     high[3] = { -1e300, -1e300, -1e300 };
-  const auto region = image->GetLargestPossibleRegion();
-  for (unsigned int corner = 0; corner < 8; ++corner)
-  {
-    itk::ContinuousIndex<double, 3> index;
-    for (unsigned int k = 0; k < 3; ++k)
-    {
-      index[k] = region.GetIndex()[k] - 0.5 + ((corner >> k) & 1 ? region.GetSize()[k] : 0);
-    }
-    MeshType::PointType p;
-    image->TransformContinuousIndexToPhysicalPoint(index, p);
-    for (unsigned int k = 0; k < 3; ++k)
-    {
-      low[k] = std::min(low[k], p[k]);
-      high[k] = std::max(high[k], p[k]);
-    }
-  }
-  return "x " + Format(low[0], 6) + " to " + Format(high[0], 6) + ", y " + Format(low[1], 6) + " to " +
-         Format(high[1], 6) + ", z " + Format(low[2], 6) + " to " + Format(high[2], 6) + " mm";
 }
 
 MeshType::Pointer
@@ -399,35 +339,9 @@ Deform(const ImageType *        image,
        const SnapshotCallback & snapshot = SnapshotCallback())
 {
   DeformResult result;
-  result.sigma = o.sigma >= 0.0 ? o.sigma : defaults::SigmaInVoxels * SmallestSpacing(image);
-  const double scaleBase = result.sigma > 0.0 ? result.sigma : SmallestSpacing(image);
-  result.scale = o.scale >= 0.0 ? o.scale : defaults::ScaleOverSigma * scaleBase;
-
-  auto force = ForceFilterType::New();
-  force->SetInput(image);
-  force->SetSigma(result.sigma);
-  force->SetNormalizeForces(o.normalizeForces);
-  force->SetUseGradientVectorFlow(o.gradientVectorFlow);
-  force->SetGradientVectorFlowRegularization(o.gradientVectorFlowRegularization);
-  force->SetGradientVectorFlowIterations(o.gradientVectorFlowIterations);
-  progress.Start("force field");
-  force->AddObserver(itk::ProgressEvent(),
-                     [&](const itk::EventObject &) { progress.Update(force->GetProgress(), ""); });
-  const auto start = std::chrono::steady_clock::now();
-  try
-  {
-    force->Update();
-  }
-  catch (const itk::ExceptionObject & exception)
-  {
-    throw Error("force field: " + OneLine(exception.GetDescription()));
-  }
-  result.force = force->GetOutput();
-  const auto seconds = [&start]() {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  };
-  progress.Finish("sigma " + Format(result.sigma) + " mm" + (o.gradientVectorFlow ? ", gradient vector flow" : "") +
-                  (o.normalizeForces ? ", normalised" : ", not normalised") + " (" + Format(seconds(), 2) + " s)");
+  result.sigma = ForceSigma(image, o);
+  result.scale = ForceScale(image, o);
+  result.force = ComputeForceField<ForceFilterType>(image, o, progress);
 
   // Coarse to fine: the surface first converges at the resolution it is
   // given (the coarse default sphere, whose long edges bridge pockets such as
@@ -436,22 +350,21 @@ Deform(const ImageType *        image,
   // into four) and deformed again, until its mean edge length reaches
   // --edge-length. The object's intensity range is estimated once, from the
   // initial surface.
-  const double regionWeight =
-    o.regionWeight >= 0.0 ? o.regionWeight : defaults::RegionWeightInVoxels * SmallestSpacing(image);
-  const double regionSigma =
-    o.regionSigma >= 0.0 ? o.regionSigma : defaults::RegionSigmaInVoxels * SmallestSpacing(image);
-  const double edgeSearchWeight =
-    o.edgeSearchWeight >= 0.0 ? o.edgeSearchWeight : defaults::EdgeSearchWeightInVoxels * SmallestSpacing(image);
-  const double edgeSearchDistance =
-    o.edgeSearchDistance > 0.0 ? o.edgeSearchDistance : defaults::EdgeSearchDistanceInVoxels * SmallestSpacing(image);
-  const double edgeLength = o.edgeLength > 0.0 ? o.edgeLength : defaults::EdgeLengthInVoxels * SmallestSpacing(image);
+  const double  smallest = SmallestSpacing(image);
+  LevelSchedule schedule;
+  schedule.scale = result.scale;
+  schedule.regionWeight = o.regionWeight >= 0.0 ? o.regionWeight : defaults::RegionWeightInVoxels * smallest;
+  schedule.regionSigma = o.regionSigma >= 0.0 ? o.regionSigma : defaults::RegionSigmaInVoxels * smallest;
+  schedule.edgeSearchWeight =
+    o.edgeSearchWeight >= 0.0 ? o.edgeSearchWeight : defaults::EdgeSearchWeightInVoxels * smallest;
+  schedule.edgeSearchDistance =
+    o.edgeSearchDistance > 0.0 ? o.edgeSearchDistance : defaults::EdgeSearchDistanceInVoxels * smallest;
+  schedule.edgeLength = o.edgeLength > 0.0 ? o.edgeLength : defaults::EdgeLengthInVoxels * smallest;
+  schedule.tangentialElasticity = o.tangentialElasticity;
+  schedule.pointsWord = "vertices";
+  schedule.initialWhat = "surface";
   MeshType::ConstPointer stageInput = initial;
-  // The object's intensity model (median and spread) is estimated once, from
-  // the initial surface; the background's bounds are estimated by every level
-  // from just outside its surface.
-  bool               haveModel = false;
-  double             model[2] = { 0.0, 0.0 };
-  itk::SizeValueType iterationsBefore = 0;
+  LevelState             state;
   if (snapshot)
   {
     snapshot(initial, 0);
@@ -462,126 +375,29 @@ Deform(const ImageType *        image,
     // The last level: refinement off (no region force), a mesh with cells
     // other than triangles (not refined), or a first level already fine
     // enough (later levels are decided on their output below).
-    bool last =
-      regionWeight == 0.0 || !HasOnlyTriangles(stageInput) || !(MeanEdgeLength(stageInput) > 1.5 * edgeLength);
+    bool last = schedule.regionWeight == 0.0 || !HasOnlyTriangles(stageInput) ||
+                !(MeanEdgeLength(stageInput) > 1.5 * schedule.edgeLength);
     deform->SetInput(stageInput);
     deform->SetForceImage(result.force);
-    deform->SetScaleFactor(result.scale);
-    // The capture level (the first of several) has the schedule's own
-    // internal weights; --elasticity and --rigidity shape the refined levels,
-    // which make the result. A stiffer capture mesh (1 026 points, edges of
-    // about 5 mm on a 40 mm sphere) cannot fill two lobes at once and settles
-    // in the cleft between them (ch2, elasticity 0.6: the interhemispheric
-    // fissure, Dice 0.951), a slacker one folds (0.125: 0.949); the refined
-    // levels then keep the fold.
-    const bool capture = stage == 0 && !last;
-    deform->SetElasticity(capture ? defaults::Elasticity : o.elasticity);
-    deform->SetTangentialElasticity(o.tangentialElasticity);
-    deform->SetRigidity(capture ? defaults::Rigidity : o.rigidity);
-    deform->SetBalloon(o.balloon);
     deform->SetIntensityImage(image);
-    // On refined levels finer than FineLevelEdgeLengths x --edge-length the region
-    // force is weighted by (h / that length)^2, h the level's mean edge: the
-    // membrane force of a mesh of edge h bends the surface by about
-    // a h^2 kappa / 4 per iteration, so the curvature at which it balances
-    // the region force stays that of the coarser level (the surface does not
-    // creep into sulci and fissures as its mesh is refined), and the finest
-    // level converges within its iterations.
-    const double levelEdge = MeanEdgeLength(stageInput) / (defaults::FineLevelEdgeLengths * edgeLength);
-    deform->SetRegionWeight(stage == 0 ? regionWeight : regionWeight * std::min(1.0, levelEdge * levelEdge));
-    deform->SetRegionSigma(stage == 0 && !last ? defaults::CoarseRegionSigmaFactor * regionSigma : regionSigma);
-    deform->SetIntensityTolerance(o.intensityTolerance);
-    deform->SetEdgeSearchWeight(edgeSearchWeight);
-    deform->SetEdgeSearchDistance(edgeSearchDistance);
-    if (o.hasObjectRange)
-    {
-      deform->SetObjectIntensityRange(o.objectRange[0], o.objectRange[1], 0.1 * (o.objectRange[1] - o.objectRange[0]));
-    }
-    else if (haveModel)
-    {
-      deform->SetObjectIntensityStatistics(model[0], model[1]);
-    }
-    deform->SetDampOscillations(o.dampOscillations);
+    ConfigureLevel(deform.GetPointer(), o, schedule, state, stage, last, MeanEdgeLength(stageInput));
     deform->SetPreventSelfIntersections(o.preventSelfIntersections);
     deform->SetMinimumDistance(o.minimumDistance);
-    deform->SetMaximumStepLength(o.maximumStepLength);
-    deform->SetFixedBoundary(o.fixedBoundary);
-    deform->SetConvergenceTolerance(o.convergenceTolerance);
-    deform->SetConvergenceWindow(o.convergenceWindow);
-    deform->SetConvergenceFraction(o.convergenceFraction);
-    // The capture level runs until it converges, up to CaptureIterations
-    // (or --iterations when larger): from a small sphere it travels far, and
-    // its front slows down as it fills narrow lobes (ch2: 700 iterations),
-    // so that a cap of 500 would stop it anywhere along the way and the
-    // result would depend on --iterations.
-    deform->SetNumberOfIterations(capture && o.iterations > 0 ? std::max(o.iterations, defaults::CaptureIterations)
-                                                              : o.iterations);
-    const std::string level = std::to_string(stageInput->GetNumberOfPoints()) + " points";
-    progress.Start("deforming");
-    const auto deformStart = std::chrono::steady_clock::now();
-    deform->AddObserver(itk::ProgressEvent(), [&](const itk::EventObject &) {
-      const auto total = deform->GetNumberOfIterations();
-      const auto current = deform->GetCurrentIteration();
-      progress.Update(total > 0 ? static_cast<double>(current) / total : 1.0,
-                      level + ", iteration " + std::to_string(current) + "/" + std::to_string(total) +
-                        ", largest step " + Format(deform->GetLastMaximumDisplacement()) + " mm");
-    });
-    if (snapshot)
-    {
-      deform->AddObserver(itk::IterationEvent(), [&](const itk::EventObject &) {
-        if (deform->GetCurrentIteration() % o.snapshotEvery == 0)
-        {
-          snapshot(deform->GetOutput(), iterationsBefore + deform->GetCurrentIteration());
-        }
-      });
-    }
-    try
-    {
-      deform->Update();
-    }
-    catch (const itk::ExceptionObject & exception)
-    {
-      throw Error("deformation: " + OneLine(exception.GetDescription()));
-    }
-    if (deform->GetRegionWeight() > 0.0 && !o.hasObjectRange && !haveModel)
-    {
-      haveModel = true;
-      model[0] = deform->GetObjectIntensityMedian();
-      model[1] = deform->GetObjectIntensitySpread();
-      progress.Note("region force: object intensity median " + Format(model[0], 4) + ", spread " + Format(model[1], 3) +
-                    " (estimated inside the initial surface)");
-    }
-    if (deform->GetRegionWeight() > 0.0)
-    {
-      progress.Note("region force: intensity range [" + Format(deform->GetObjectIntensityLower(), 4) + ", " +
-                    Format(deform->GetObjectIntensityUpper(), 4) + "], transition width " +
-                    Format(deform->GetObjectIntensityWidth(), 3));
-    }
-    if (snapshot && deform->GetCurrentIteration() % o.snapshotEvery != 0)
-    {
-      snapshot(deform->GetOutput(), iterationsBefore + deform->GetCurrentIteration());
-    }
-    result.iterations += deform->GetCurrentIteration();
-    iterationsBefore = result.iterations;
-    result.converged = deform->GetConverged();
-    result.lastMaximumDisplacement = deform->GetLastMaximumDisplacement();
-    const double deformSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - deformStart).count();
-    progress.Finish(
-      std::to_string(deform->GetCurrentIteration()) + " iterations on " + level + ", " +
-      (result.converged ? "converged (" +
-                            (o.convergenceFraction > 0.0
-                               ? "at most " +
-                                   std::to_string(static_cast<unsigned long long>(
-                                     o.convergenceFraction * static_cast<double>(stageInput->GetNumberOfPoints()))) +
-                                   " vertices moving by "
-                               : std::string("largest step below ")) +
-                            Format(deform->GetConvergenceTolerance()) + " mm for " +
-                            std::to_string(o.convergenceWindow) + " iterations)"
-                        : std::string("iteration cap reached")) +
-      ", last largest step " + Format(result.lastMaximumDisplacement) + " mm (" + Format(deformSeconds, 2) + " s)");
+    RunLevel(deform.GetPointer(),
+             o,
+             schedule,
+             progress,
+             stageInput->GetNumberOfPoints(),
+             state,
+             snapshot ? std::function<void(itk::SizeValueType)>(
+                          [&](itk::SizeValueType iteration) { snapshot(deform->GetOutput(), iteration); })
+                      : std::function<void(itk::SizeValueType)>());
+    result.iterations = state.iterations;
+    result.converged = state.converged;
+    result.lastMaximumDisplacement = state.lastMaximumDisplacement;
     MeshType::Pointer output = deform->GetOutput();
     output->DisconnectPipeline();
-    last = last || !(MeanEdgeLength(output) > 1.5 * edgeLength) ||
+    last = last || !(MeanEdgeLength(output) > 1.5 * schedule.edgeLength) ||
            4 * output->GetNumberOfPoints() > defaults::MaximumRefinedPoints;
     if (last)
     {
