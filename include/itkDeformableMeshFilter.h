@@ -313,7 +313,12 @@ public:
   /** Standard deviation of the Gaussian smoothing of the intensity image for
    * the region force, physical units (mm): thin dark or bright structures
    * narrower than about 2 sigma (sulci, vessels, noise) no longer stop the
-   * surface. 0: no smoothing. Non-negative. Default: 1. */
+   * surface. The Gaussian is that of ExternalForceImageFilter (sampled,
+   * truncated at 4 sigma, border pixels repeated:
+   * itkSampledGaussianSmoothing.h). The smoothed image and its statistics are
+   * kept until the intensity image or RegionSigma changes, also from one
+   * input mesh to the next (a coarse-to-fine schedule can reuse one filter).
+   * 0: no smoothing. Non-negative. Default: 1. */
   itkSetMacro(RegionSigma, double);
   itkGetConstMacro(RegionSigma, double);
 

@@ -23,7 +23,7 @@
 // per-vertex outward speeds the step adds along the normals. Included by
 // itkDeformableMeshFilter.hxx.
 
-#include "itkSmoothingRecursiveGaussianImageFilter.h"
+#include "itkSampledGaussianSmoothing.h"
 
 namespace itk
 {
@@ -102,52 +102,58 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareImageTerms()
     // statistics neither overflow nor lose their precision in float.
     const float * buffer = image->GetBufferPointer();
     const size_t  count = image->GetBufferedRegion().GetNumberOfPixels();
-    float         largest = 0.0f;
+    // The largest magnitude, in a loop without branches (vectorised): a
+    // non-finite value makes it infinite or NaN, and is then looked for.
+    float largest = 0.0f;
     for (size_t i = 0; i < count; ++i)
     {
-      if (!std::isfinite(buffer[i]))
+      const float magnitude = std::abs(buffer[i]);
+      largest = magnitude > largest || magnitude != magnitude ? magnitude : largest;
+    }
+    if (!std::isfinite(largest))
+    {
+      for (size_t i = 0; i < count; ++i)
       {
-        itkExceptionMacro("The intensity image holds a non-finite value (" << buffer[i] << ") at offset " << i
-                                                                           << " of its buffer.");
+        if (!std::isfinite(buffer[i]))
+        {
+          itkExceptionMacro("The intensity image holds a non-finite value (" << buffer[i] << ") at offset " << i
+                                                                             << " of its buffer.");
+        }
       }
-      largest = std::max(largest, std::abs(buffer[i]));
     }
     m_IntensityScale = 1.0;
     if (largest > 0.0f && (largest > std::ldexp(1.0f, 40) || largest < std::ldexp(1.0f, -40)))
     {
       m_IntensityScale = std::ldexp(1.0, -std::ilogb(largest));
     }
-    typename IntensityImageType::ConstPointer source = image;
+    // The intensities (scaled) into the image to smooth, with the Gaussian
+    // of ExternalForceImageFilter (itkSampledGaussianSmoothing.h); in double
+    // for the scaling: 2^133 (the scale of a denormal maximum) is no float.
+    typename IntensityImageType::Pointer smoothed = IntensityImageType::New();
+    smoothed->CopyInformation(image);
+    smoothed->SetRegions(image->GetBufferedRegion());
+    smoothed->Allocate();
+    float * out = smoothed->GetBufferPointer();
     if (m_IntensityScale != 1.0)
     {
-      auto scaled = IntensityImageType::New();
-      scaled->CopyInformation(image);
-      scaled->SetRegions(image->GetBufferedRegion());
-      scaled->Allocate();
-      // In double: 2^133 (the scale of a denormal maximum) is no float.
-      float * out = scaled->GetBufferPointer();
       for (size_t i = 0; i < count; ++i)
       {
         out[i] = static_cast<float>(static_cast<double>(buffer[i]) * m_IntensityScale);
       }
-      source = scaled;
-    }
-    typename IntensityImageType::Pointer smoothed;
-    if (m_RegionSigma > 0.0)
-    {
-      using SmoothingType = SmoothingRecursiveGaussianImageFilter<IntensityImageType, IntensityImageType>;
-      auto smoothing = SmoothingType::New();
-      smoothing->SetInput(source);
-      smoothing->SetSigma(m_RegionSigma);
-      smoothing->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
-      smoothing->Update();
-      smoothed = smoothing->GetOutput();
-      smoothed->DisconnectPipeline();
     }
     else
     {
-      smoothed = IntensityImageType::New();
-      smoothed->Graft(source);
+      std::copy(buffer, buffer + count, out);
+    }
+    if (m_RegionSigma > 0.0)
+    {
+      typename IntensityImageType::Pointer scratch = IntensityImageType::New();
+      scratch->CopyInformation(image);
+      scratch->SetRegions(image->GetBufferedRegion());
+      scratch->Allocate();
+      MultiThreaderBase * threader = this->GetMultiThreader();
+      threader->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
+      SmoothWithSampledGaussian<IntensityImageType>(smoothed, scratch, m_RegionSigma, threader);
     }
     if constexpr (PointDimension == 3)
     {

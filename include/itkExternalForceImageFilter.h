@@ -165,11 +165,6 @@ private:
   void
   ComputeForceField(const InputImageType * input);
 
-  /** Sum of exp(-k^2 / (2 sigma^2)) for the integers k from \a first to
-   * \a last: the taps of the Gaussian folded onto the border pixels. */
-  static double
-  GaussianTailSum(double first, double last, double sigma);
-
   /** The input as floats, smoothed by a Gaussian of standard deviation Sigma
    * (physical units): separable, sampled and truncated at 4 Sigma along each
    * axis, border pixels repeated, threaded over lines and rows of pixels. */

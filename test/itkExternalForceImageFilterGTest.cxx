@@ -19,6 +19,7 @@
 #include "itkEllipsoidPhantom.h"
 #include "itkExternalForceImageFilter.h"
 #include "itkImageRegionIteratorWithIndex.h"
+#include "itkSampledGaussianSmoothing.h"
 #include "edmTestUtilities.h"
 #include "gtest/gtest.h"
 
@@ -95,6 +96,74 @@ TEST(ExternalForceImageFilter, SmoothsWithAGaussianOfSigmaInPhysicalUnits)
   {
     const double ratio = expected(position(i)) / expected(position(35));
     EXPECT_NEAR(force(i) / force(35), ratio, 0.08 * std::abs(ratio)) << "x = " << position(i) << " mm";
+  }
+}
+
+TEST(SampledGaussianSmoothing, ImpulseResponseIsTheNormalisedGaussianInPhysicalUnits)
+{
+  // The smoothing of the force field and of the region force
+  // (itkSampledGaussianSmoothing.h): an impulse in the middle of a 2-D image
+  // of 0.5 x 2 mm pixels, sigma 1.5 mm, gives exp(-x^2 / (2 s^2)) exp(-y^2 /
+  // (2 s^2)) sampled at the pixel centres, normalised to a unit sum along
+  // each axis; a constant image stays constant (the border pixels repeat).
+  using FloatImageType = itk::Image<float, 2>;
+  const auto make = [](float value) {
+    auto                     image = FloatImageType::New();
+    FloatImageType::SizeType size = { { 41, 21 } };
+    image->SetRegions(size);
+    FloatImageType::SpacingType spacing;
+    spacing[0] = 0.5;
+    spacing[1] = 2.0;
+    image->SetSpacing(spacing);
+    image->Allocate();
+    image->FillBuffer(value);
+    return image;
+  };
+  FloatImageType::Pointer impulse = make(0.0f);
+  impulse->SetPixel({ { 20, 10 } }, 1.0f);
+  FloatImageType::Pointer scratch = make(0.0f);
+  auto                    threader = itk::MultiThreaderBase::New();
+  itk::SmoothWithSampledGaussian<FloatImageType>(impulse, scratch, 1.5, threader);
+  const auto axisWeights = [](double spacing, int radius) {
+    std::vector<double> w;
+    double              sum = 0.0;
+    for (int k = -radius; k <= radius; ++k)
+    {
+      w.push_back(std::exp(-0.5 * (k * spacing / 1.5) * (k * spacing / 1.5)));
+      sum += w.back();
+    }
+    for (double & v : w)
+    {
+      v /= sum;
+    }
+    return w;
+  };
+  const std::vector<double> wx = axisWeights(0.5, 12); // 4 sigma = 12 pixels of 0.5 mm
+  const std::vector<double> wy = axisWeights(2.0, 3);  // ceil(4 sigma / 2 mm) = 3 pixels
+  double                    total = 0.0;
+  for (int j = 0; j < 21; ++j)
+  {
+    for (int i = 0; i < 41; ++i)
+    {
+      const double value = impulse->GetPixel({ { i, j } });
+      total += value;
+      const int    di = i - 20;
+      const int    dj = j - 10;
+      const double expected = std::abs(di) <= 12 && std::abs(dj) <= 3 ? wx[di + 12] * wy[dj + 3] : 0.0;
+      EXPECT_NEAR(value, expected, 1e-6) << "pixel " << i << ", " << j;
+    }
+  }
+  EXPECT_NEAR(total, 1.0, 1e-5);
+
+  FloatImageType::Pointer constant = make(7.0f);
+  scratch = make(0.0f);
+  itk::SmoothWithSampledGaussian<FloatImageType>(constant, scratch, 1.5, threader);
+  for (int j = 0; j < 21; j += 5)
+  {
+    for (int i = 0; i < 41; i += 4)
+    {
+      EXPECT_NEAR(constant->GetPixel({ { i, j } }), 7.0f, 1e-5f) << "pixel " << i << ", " << j;
+    }
   }
 }
 

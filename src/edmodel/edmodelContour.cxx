@@ -966,6 +966,9 @@ DeformContours(const Image2DType *     image,
   {
     snapshot(initial, 0);
   }
+  // One filter for all levels: its smoothed intensity image and statistics
+  // are kept from one level to the next when the region sigma is the same.
+  auto deform = ContourFilterType::New();
   for (unsigned int stage = 0;; ++stage)
   {
     // Unlike the 3-D sphere, the initial circle is often already as fine as
@@ -973,7 +976,6 @@ DeformContours(const Image2DType *     image,
     // then a capture level anyway, and a last level at the same resolution
     // follows it.
     const bool last = schedule.regionWeight == 0.0;
-    auto       deform = ContourFilterType::New();
     deform->SetInput(ToMesh(stageInput));
     deform->SetForceImage(result.force);
     deform->SetIntensityImage(image);

@@ -369,9 +369,11 @@ Deform(const ImageType *        image,
   {
     snapshot(initial, 0);
   }
+  // One filter for all levels: its smoothed intensity image and statistics
+  // are kept from one level to the next when the region sigma is the same.
+  auto deform = DeformFilterType::New();
   for (unsigned int stage = 0;; ++stage)
   {
-    auto deform = DeformFilterType::New();
     // The last level: refinement off (no region force), a mesh with cells
     // other than triangles (not refined), or a first level already fine
     // enough (later levels are decided on their output below).

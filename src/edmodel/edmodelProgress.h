@@ -51,6 +51,25 @@ public:
     m_Drawn = false;
   }
 
+  /** True when Update(fraction, ...) would draw: callers that build their
+   * detail text at every iteration ask first (the text costs more than a
+   * small contour's iteration). */
+  bool
+  Due(double fraction) const
+  {
+    if (!m_Enabled)
+    {
+      return false;
+    }
+    fraction = std::min(1.0, std::max(0.0, fraction));
+    if (m_Terminal)
+    {
+      return fraction >= 1.0 || !m_Drawn ||
+             std::chrono::steady_clock::now() - m_LastDraw >= std::chrono::milliseconds(100);
+    }
+    return static_cast<int>(fraction * 10.0 + 1e-9) > m_LastTenth;
+  }
+
   void
   Update(double fraction, const std::string & detail)
   {

@@ -296,9 +296,14 @@ RunLevel(TFilter *                                       deform,
   progress.Start("deforming");
   const auto    start = std::chrono::steady_clock::now();
   const auto    progressTag = deform->AddObserver(itk::ProgressEvent(), [&](const itk::EventObject &) {
-    const auto total = deform->GetNumberOfIterations();
-    const auto current = deform->GetCurrentIteration();
-    progress.Update(total > 0 ? static_cast<double>(current) / total : 1.0,
+    const auto   total = deform->GetNumberOfIterations();
+    const auto   current = deform->GetCurrentIteration();
+    const double fraction = total > 0 ? static_cast<double>(current) / total : 1.0;
+    if (!progress.Due(fraction))
+    {
+      return;
+    }
+    progress.Update(fraction,
                     level + ", iteration " + std::to_string(current) + "/" + std::to_string(total) + ", largest step " +
                       Format(deform->GetLastMaximumDisplacement()) + " mm");
   });
