@@ -2156,6 +2156,25 @@ CountSurfaceCells(const MeshType * mesh)
 
 namespace
 {
+/** Every coordinate finite and within 1e12 of 0 (what is "mesh" or
+ * "contour" in the message). */
+void
+CheckCoordinates(const MeshType * mesh, const char * what, const std::string & path, const std::string & option)
+{
+  for (auto it = mesh->GetPoints()->Begin(); it != mesh->GetPoints()->End(); ++it)
+  {
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      if (!(std::abs(it.Value()[k]) <= 1e12))
+      {
+        throw Error(option + ": " + what + " " + Quote(path) + " has point " + std::to_string(it.Index()) + " at " +
+                    FormatNumber(it.Value()[0]) + ", " + FormatNumber(it.Value()[1]) + ", " +
+                    FormatNumber(it.Value()[2]) + ": edmodel needs finite coordinates within 1e+12 of 0");
+      }
+    }
+  }
+}
+
 MeshType::Pointer
 CheckSurfaceMesh(MeshType::Pointer mesh, const std::string & path, const std::string & option)
 {
@@ -2167,18 +2186,7 @@ CheckSurfaceMesh(MeshType::Pointer mesh, const std::string & path, const std::st
   {
     throw Error(option + ": mesh " + Quote(path) + " has no triangles (a surface mesh is needed)");
   }
-  for (auto it = mesh->GetPoints()->Begin(); it != mesh->GetPoints()->End(); ++it)
-  {
-    for (unsigned int k = 0; k < 3; ++k)
-    {
-      if (!(std::abs(it.Value()[k]) <= 1e12))
-      {
-        throw Error(option + ": mesh " + Quote(path) + " has point " + std::to_string(it.Index()) + " at " +
-                    FormatNumber(it.Value()[0]) + ", " + FormatNumber(it.Value()[1]) + ", " +
-                    FormatNumber(it.Value()[2]) + ": edmodel needs finite coordinates within 1e+12 of 0");
-      }
-    }
-  }
+  CheckCoordinates(mesh, "mesh", path, option);
   return mesh;
 }
 } // namespace
@@ -2304,18 +2312,7 @@ ReadCurveMesh(const std::string & path, const std::string & option)
     }
     throw Error(option + ": " + error.what());
   }
-  for (auto it = mesh->GetPoints()->Begin(); it != mesh->GetPoints()->End(); ++it)
-  {
-    for (unsigned int k = 0; k < 3; ++k)
-    {
-      if (!(std::abs(it.Value()[k]) <= 1e12))
-      {
-        throw Error(option + ": contour " + Quote(path) + " has point " + std::to_string(it.Index()) + " at " +
-                    FormatNumber(it.Value()[0]) + ", " + FormatNumber(it.Value()[1]) + ", " +
-                    FormatNumber(it.Value()[2]) + ": edmodel needs finite coordinates within 1e+12 of 0");
-      }
-    }
-  }
+  CheckCoordinates(mesh, "contour", path, option);
   return mesh;
 }
 
