@@ -225,7 +225,6 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::Smooth(const InputImageType
   typename RealImageType::Pointer
 {
   const auto          region = input->GetBufferedRegion();
-  const auto          size = region.GetSize();
   const SizeValueType numberOfPixels = region.GetNumberOfPixels();
   auto                makeImage = [&]() {
     auto image = RealImageType::New();
