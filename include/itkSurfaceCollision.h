@@ -1052,6 +1052,7 @@ public:
       }
     }
     m_SharedGaps.assign(numberOfSharedPairs, 0.0f);
+    m_SharedExact.assign(numberOfSharedPairs, 0);
     m_HasSurface = true;
     this->Invalidate();
   }
@@ -1273,8 +1274,7 @@ public:
             {
               continue;
             }
-            if (LargestDistance(bt, m_TriangleDelta.data() + 6 * u) <
-                static_cast<double>(m_SharedGaps[q]) - m_ContactDistance)
+            if (this->SharedPairClear(q, LargestDistance(bt, m_TriangleDelta.data() + 6 * u)))
             {
               continue;
             }
@@ -1304,8 +1304,7 @@ public:
         {
           const IndexType q = m_SharedOfTriangle[k];
           const IndexType u = this->OtherOfShared(q, t);
-          if ((m_IsLarge[u] && u < t) || LargestDistance(bt, m_TriangleDelta.data() + 6 * u) <
-                                           static_cast<double>(m_SharedGaps[q]) - m_ContactDistance)
+          if ((m_IsLarge[u] && u < t) || this->SharedPairClear(q, LargestDistance(bt, m_TriangleDelta.data() + 6 * u)))
           {
             continue;
           }
@@ -1683,6 +1682,94 @@ private:
     return SurfaceCollisionDetail::SharedVertexGap(a, i, b, j);
   }
 
+  /** A lower bound of SharedGap(q, x), cheap: the largest separation of
+   * the far edge of one triangle and the other triangle along a few axes
+   * (the line between the far edges' midpoints, the triangles' normals), the
+   * smaller of the two. */
+  double
+  SharedGapLowerBound(SizeValueType q, const double * x) const
+  {
+    const IndexType * vt = m_Triangles.data() + 3 * m_SharedPairs[2 * q];
+    const IndexType * vu = m_Triangles.data() + 3 * m_SharedPairs[2 * q + 1];
+    unsigned int      i = 0;
+    unsigned int      j = 0;
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      for (unsigned int l = 0; l < 3; ++l)
+      {
+        if (vt[k] == vu[l])
+        {
+          i = k;
+          j = l;
+        }
+      }
+    }
+    using namespace SurfaceCollisionDetail;
+    const double * v = x + 3 * vt[i];
+    double         p[3], q1[3], r[3], s[3];
+    Subtract(x + 3 * vt[(i + 1) % 3], v, p);
+    Subtract(x + 3 * vt[(i + 2) % 3], v, q1);
+    Subtract(x + 3 * vu[(j + 1) % 3], v, r);
+    Subtract(x + 3 * vu[(j + 2) % 3], v, s);
+    // The separation of the far edge {e0, e1} of one triangle from the
+    // other triangle {0, f0, f1} (coordinates relative to the shared vertex):
+    // the largest along the other triangle's normal, its two edges' normals
+    // in its plane at the shared vertex (pointing away from it), and the
+    // line from its far edge's midpoint to the far edge's midpoint.
+    const auto bound = [](const double * e0, const double * e1, const double * f0, const double * f1) {
+      double axes[4][3];
+      Cross(f0, f1, axes[0]);
+      Cross(f0, axes[0], axes[1]);
+      Cross(axes[0], f1, axes[2]);
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        axes[3][k] = (e0[k] + e1[k]) - (f0[k] + f1[k]);
+      }
+      double best = 0.0;
+      for (const auto & axis : axes)
+      {
+        const double length = std::sqrt(Dot(axis, axis));
+        if (!(length > 0.0))
+        {
+          continue;
+        }
+        const double e[2] = { Dot(axis, e0), Dot(axis, e1) };
+        const double f[2] = { Dot(axis, f0), Dot(axis, f1) };
+        const double above = std::min(e[0], e[1]) - std::max({ 0.0, f[0], f[1] });
+        const double below = std::min({ 0.0, f[0], f[1] }) - std::max(e[0], e[1]);
+        best = std::max(best, std::max(above, below) / length);
+      }
+      return best;
+    };
+    const double first = bound(p, q1, r, s);
+    const double second = bound(r, s, p, q1);
+    // Rounding of the differences and projections: a margin relative to the
+    // coordinates' magnitude.
+    const double scale = std::sqrt(std::max({ Dot(p, p), Dot(q1, q1), Dot(r, r), Dot(s, s) })) + std::abs(v[0]) +
+                         std::abs(v[1]) + std::abs(v[2]);
+    return std::max(0.0, std::min(first, second) - 1e-12 * scale);
+  }
+
+  /** Shared pair q cannot violate while the relative motion of its
+   * triangles is below \a motion: its gap at the reference less the
+   * contact distance is above the motion (with the exact gap computed once
+   * per rebuild when the bound does not tell). */
+  bool
+  SharedPairClear(SizeValueType q, double motion)
+  {
+    if (motion < static_cast<double>(m_SharedGaps[q]) - m_ContactDistance)
+    {
+      return true;
+    }
+    if (m_SharedExact[q])
+    {
+      return false;
+    }
+    m_SharedGaps[q] = RoundDown(this->SharedGap(q, m_Reference.data()));
+    m_SharedExact[q] = 1;
+    return motion < static_cast<double>(m_SharedGaps[q]) - m_ContactDistance;
+  }
+
   /** Shared pair q violates at y: its gap is below the contact distance c
    * and below its gap at x (the two triangles fold into each other). */
   bool
@@ -1911,7 +1998,8 @@ private:
     parallel(m_SharedGaps.size(), [&](SizeValueType begin, SizeValueType end) {
       for (SizeValueType q = begin; q < end; ++q)
       {
-        m_SharedGaps[q] = RoundDown(this->SharedGap(q, x));
+        m_SharedExact[q] = 0;
+        m_SharedGaps[q] = RoundDown(this->SharedGapLowerBound(q, x));
       }
     });
     parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
@@ -2318,7 +2406,8 @@ private:
   std::vector<IndexType>     m_SharedPairs;      // pairs sharing exactly one vertex: t, u (t < u)
   std::vector<IndexType>     m_SharedOffsets;    // triangle -> range of m_SharedOfTriangle
   std::vector<IndexType>     m_SharedOfTriangle; // the shared pairs each triangle is in
-  std::vector<float>         m_SharedGaps;       // per shared pair: its gap at the reference, rounded down
+  std::vector<float>         m_SharedGaps;       // per shared pair: a lower bound of its gap at the reference
+  std::vector<uint8_t>       m_SharedExact;      // per shared pair: the bound is the exact gap
 
   // The index (see the class documentation).
   bool                            m_IndexValid{ false };
