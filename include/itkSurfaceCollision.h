@@ -734,6 +734,11 @@ public:
         }
       });
     }
+    m_EntryBoxes.resize(6 * m_Entries.size());
+    for (SizeValueType e = 0; e < m_Entries.size(); ++e)
+    {
+      std::copy(boxes + 6 * m_Entries[e], boxes + 6 * m_Entries[e] + 6, m_EntryBoxes.data() + 6 * e);
+    }
   }
 
   /** Calls f(u) for every box u != t that overlaps box t, once each. */
@@ -811,11 +816,64 @@ public:
     return m_Entries.size();
   }
 
+  SizeValueType
+  GetNumberOfBuckets() const
+  {
+    return m_BucketOffsets.empty() ? 0 : m_BucketOffsets.size() - 1;
+  }
+
+  /** Calls f(t, u), t < u, for every pair of overlapping boxes whose
+   * intersection's lower corner lies in a cell of the buckets [begin, end):
+   * over all buckets, every overlapping pair once. The pairs of one bucket
+   * are enumerated from its entries, with the boxes copied in bucket order
+   * (read in sequence). */
+  template <typename TFunction>
+  void
+  ForEachPair(SizeValueType begin, SizeValueType end, TFunction && f) const
+  {
+    for (SizeValueType bucket = begin; bucket < end; ++bucket)
+    {
+      const SizeValueType first = m_BucketOffsets[bucket];
+      const SizeValueType last = m_BucketOffsets[bucket + 1];
+      for (SizeValueType i = first; i + 1 < last; ++i)
+      {
+        const float * a = m_EntryBoxes.data() + 6 * i;
+        for (SizeValueType j = i + 1; j < last; ++j)
+        {
+          const float * b = m_EntryBoxes.data() + 6 * j;
+          if (a[0] > b[3] || b[0] > a[3] || a[1] > b[4] || b[1] > a[4] || a[2] > b[5] || b[2] > a[5])
+          {
+            continue;
+          }
+          // The cell of the lower corner of the boxes' intersection: the
+          // pair belongs to this bucket when that cell hashes to it.
+          if (this->Bucket(this->CellOf(std::max(a[0], b[0]), 0),
+                           this->CellOf(std::max(a[1], b[1]), 1),
+                           this->CellOf(std::max(a[2], b[2]), 2)) != bucket)
+          {
+            continue;
+          }
+          const SizeValueType t = m_Entries[i];
+          const SizeValueType u = m_Entries[j];
+          if (t < u)
+          {
+            f(t, u);
+          }
+          else
+          {
+            f(u, t);
+          }
+        }
+      }
+    }
+  }
+
   void
   Clear()
   {
     std::vector<SizeValueType>().swap(m_BucketOffsets);
     std::vector<uint32_t>().swap(m_Entries);
+    std::vector<float>().swap(m_EntryBoxes);
     m_Boxes = nullptr;
     m_NumberOfBoxes = 0;
   }
@@ -856,6 +914,7 @@ private:
   uint64_t                   m_Mask{ 0 };
   std::vector<SizeValueType> m_BucketOffsets;
   std::vector<uint32_t>      m_Entries;
+  std::vector<float>         m_EntryBoxes; // the boxes of m_Entries, in its order
 };
 
 /** Writes the float box of the points (3 doubles each) given, widened by
@@ -1910,17 +1969,19 @@ private:
       IndexType u;
       float     gap;
     };
-    const SizeValueType            blocks = (numberOfTriangles + 1023) / 1024;
+    // The overlapping pairs of boxes, enumerated bucket by bucket (each
+    // pair once, the boxes read in sequence).
+    const SizeValueType            buckets = grid.GetNumberOfBuckets();
+    const SizeValueType            blocks = (buckets + 1023) / 1024;
     std::vector<std::vector<Pair>> pairs(blocks);
-    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+    parallel(buckets, [&](SizeValueType begin, SizeValueType end) {
       auto & out = pairs[begin / 1024];
-      for (SizeValueType t = begin; t < end; ++t)
-      {
-        const IndexType * vt = m_Triangles.data() + 3 * t;
-        const double *    st = m_Spheres.data() + 4 * t;
-        grid.ForEachOverlap(t, [&](SizeValueType u) {
+      grid.ForEachPair(begin, end, [&](SizeValueType t, SizeValueType u) {
+        {
+          const IndexType * vt = m_Triangles.data() + 3 * t;
+          const double *    st = m_Spheres.data() + 4 * t;
           const IndexType * vu = m_Triangles.data() + 3 * u;
-          if (u < t || SurfaceCollisionDetail::ShareVertex(vt, vu))
+          if (SurfaceCollisionDetail::ShareVertex(vt, vu))
           {
             return;
           }
@@ -1931,7 +1992,13 @@ private:
           const double * su = m_Spheres.data() + 4 * u;
           double         e[3];
           SurfaceCollisionDetail::Subtract(su, st, e);
-          const double centres = std::sqrt(SurfaceCollisionDetail::Dot(e, e));
+          const double centres2 = SurfaceCollisionDetail::Dot(e, e);
+          const double reach = radius + st[3] + su[3];
+          if (centres2 >= reach * reach * (1.0 + 1e-12))
+          {
+            return; // the spheres' gap alone is beyond the radius
+          }
+          const double centres = std::sqrt(centres2);
           double       gap = centres - st[3] - su[3];
           if (centres > 0.0)
           {
@@ -1949,8 +2016,8 @@ private:
             return;
           }
           out.push_back({ static_cast<IndexType>(t), static_cast<IndexType>(u), RoundDown(std::max(gap, 0.0)) });
-        });
-      }
+        }
+      });
     });
     m_CandidateOffsets.assign(numberOfTriangles + 1, 0);
     for (const auto & block : pairs)
