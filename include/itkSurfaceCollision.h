@@ -1459,11 +1459,24 @@ public:
 
     // Reduce the displacements of the violating pairs' points, test the
     // pairs of the modified triangles again, until none violates.
+    // When the index bounds every state between x and y (the displacement
+    // boxes of x - r and y - r together), the modified triangles are tested
+    // against their candidate and shared pairs (and, when there are large
+    // triangles, the reference grid) instead of a grid of every triangle's
+    // box swept from x to y.
     std::vector<IndexType> touched;
     std::vector<IndexType> triangles;
+    bool                   sweptBounded = false;
+    if (!violating.empty() && !sweptGridBuilt)
+    {
+      sweptBounded = this->Bound(y, parallel, x) == BoundStatus::Bounded;
+    }
     while (!violating.empty())
     {
-      buildSweptGrid();
+      if (!sweptBounded)
+      {
+        buildSweptGrid();
+      }
       std::sort(violating.begin(), violating.end());
       violating.erase(std::unique(violating.begin(), violating.end()), violating.end());
       result.violations += violating.size();
@@ -1507,17 +1520,26 @@ public:
       violating.clear();
       for (const IndexType t : triangles)
       {
-        m_SweptGrid.ForEachOverlap(t, [&](SizeValueType u) {
-          if (SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
-          {
-            return;
-          }
+        const auto test = [&](SizeValueType u) {
           if (this->Violates(t, u, x, y, d))
           {
             violating.emplace_back(std::min<IndexType>(t, static_cast<IndexType>(u)),
                                    std::max<IndexType>(t, static_cast<IndexType>(u)));
           }
-        });
+        };
+        if (sweptBounded)
+        {
+          this->ForEachBoundedPartner(t, d, test);
+        }
+        else
+        {
+          m_SweptGrid.ForEachOverlap(t, [&](SizeValueType u) {
+            if (!SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
+            {
+              test(u);
+            }
+          });
+        }
         for (IndexType k = m_SharedOffsets[t]; k < m_SharedOffsets[t + 1]; ++k)
         {
           const IndexType q = m_SharedOfTriangle[k];
@@ -1736,6 +1758,45 @@ private:
       count += (t[i] == u[0]) + (t[i] == u[1]) + (t[i] == u[2]);
     }
     return count;
+  }
+
+  /** Calls f(u) for every triangle u sharing no vertex with t that may
+   * come within d of it while the displacements since the reference stay in
+   * the boxes of the last Bound() (which held): t's candidates whose pair
+   * bound does not clear them and, when there are large triangles, the pairs
+   * of t with a large triangle found in the reference grid. Other pairs are
+   * kept apart by the cells' bounds. */
+  template <typename TFunction>
+  void
+  ForEachBoundedPartner(SizeValueType t, double d, TFunction && f)
+  {
+    const float * bt = m_TriangleDelta.data() + 6 * t;
+    for (SizeValueType c = m_CandidateOffsets[t]; c < m_CandidateOffsets[t + 1]; ++c)
+    {
+      const IndexType u = m_Candidates[c];
+      if (LargestDistance(bt, m_TriangleDelta.data() + 6 * u) < static_cast<double>(m_CandidateGaps[c]) - d)
+      {
+        continue;
+      }
+      f(u);
+    }
+    if (m_Large.empty())
+    {
+      return;
+    }
+    const double reach = LargestDistance(bt, m_GlobalDelta) + d;
+    double       lo[3], hi[3];
+    TriangleBox(m_Reference.data(), m_Triangles.data() + 3 * t, lo, hi);
+    float query[6];
+    SurfaceCollisionDetail::StoreBox(lo, hi, reach, query);
+    m_ReferenceGrid.ForEachOverlapOfBox(query, t, [&](SizeValueType u) {
+      if ((!m_IsLarge[t] && !m_IsLarge[u]) ||
+          SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
+      {
+        return;
+      }
+      f(u);
+    });
   }
 
   /** The triangle of shared pair q other than t. */
@@ -2311,7 +2372,7 @@ private:
    * whose rho reaches their clearance. */
   template <typename TParallel>
   BoundStatus
-  Bound(const double * y, TParallel && parallel)
+  Bound(const double * y, TParallel && parallel, const double * x = nullptr)
   {
     const SizeValueType n = m_NumberOfPoints;
     const double        d = std::max(m_MinimumDistance, m_ContactDistance);
@@ -2323,9 +2384,17 @@ private:
         float * box = m_VertexDelta.data() + 6 * i;
         for (unsigned int k = 0; k < 3; ++k)
         {
-          const double delta = y[3 * i + k] - m_Reference[3 * i + k];
-          blockFinite = blockFinite && std::isfinite(delta);
-          box[k] = RoundDown(delta);
+          double delta = y[3 * i + k] - m_Reference[3 * i + k];
+          double low = delta;
+          if (x != nullptr)
+          {
+            // The box of x - r and y - r: every state between x and y.
+            const double other = x[3 * i + k] - m_Reference[3 * i + k];
+            low = std::min(delta, other);
+            delta = std::max(delta, other);
+          }
+          blockFinite = blockFinite && std::isfinite(delta) && std::isfinite(low);
+          box[k] = RoundDown(low);
           box[3 + k] = RoundUp(delta);
         }
       }
