@@ -26,6 +26,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <utility>
 #include <vector>
@@ -71,6 +72,175 @@ Orient3D(const double * a, const double * b, const double * c, const double * d)
   Subtract(d, a, ad);
   Cross(ab, ac, n);
   return Dot(n, ad);
+}
+
+/** Exact signs of the orientation determinants. A floating-point
+ * evaluation decides when its magnitude exceeds a bound of its rounding
+ * error (the usual case); otherwise the determinant is summed exactly as an
+ * expansion (a sum of non-overlapping doubles, error-free transformations:
+ * TwoSum and the fused multiply-add's TwoProduct), so that nearly coplanar
+ * points (a flat patch of a subdivided mesh, which the plain determinants
+ * call crossing or not at random) get their true sign. */
+class ExactSum
+{
+public:
+  /** Adds a double exactly (Grow-Expansion with zero elimination). */
+  void
+  Add(double b)
+  {
+    double      q = b;
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < m_Terms.size(); ++i)
+    {
+      const double e = m_Terms[i];
+      const double sum = q + e;
+      const double bv = sum - q;
+      const double av = sum - bv;
+      const double low = (q - av) + (e - bv);
+      q = sum;
+      if (low != 0.0)
+      {
+        m_Terms[kept++] = low;
+      }
+    }
+    m_Terms.resize(kept);
+    if (q != 0.0)
+    {
+      m_Terms.push_back(q);
+    }
+  }
+
+  /** Adds the exact product p q r (four doubles). */
+  void
+  AddProduct(double p, double q, double r)
+  {
+    const double hi = p * q;
+    const double lo = std::fma(p, q, -hi);
+    for (const double s : { hi, lo })
+    {
+      const double h = s * r;
+      this->Add(std::fma(s, r, -h));
+      this->Add(h);
+    }
+  }
+
+  /** Sign of the sum: that of its largest term. */
+  int
+  Sign() const
+  {
+    return m_Terms.empty() ? 0 : (m_Terms.back() > 0.0 ? 1 : -1);
+  }
+
+private:
+  std::vector<double> m_Terms; // non-zero, non-overlapping, of increasing magnitude
+};
+
+/** b - a exactly as hi + lo. */
+inline void
+TwoDifference(double b, double a, double & hi, double & lo)
+{
+  hi = b - a;
+  const double bv = b - hi;
+  const double av = hi + bv;
+  lo = (b - av) + (bv - a);
+}
+
+/** Sign of Orient3D(a, b, c, d), exact. */
+inline int
+Orient3DSign(const double * a, const double * b, const double * c, const double * d)
+{
+  double ab[3], ac[3], ad[3];
+  Subtract(b, a, ab);
+  Subtract(c, a, ac);
+  Subtract(d, a, ad);
+  const double m0 = ab[1] * ac[2] - ab[2] * ac[1];
+  const double m1 = ab[2] * ac[0] - ab[0] * ac[2];
+  const double m2 = ab[0] * ac[1] - ab[1] * ac[0];
+  const double det = m0 * ad[0] + m1 * ad[1] + m2 * ad[2];
+  const double permanent = (std::abs(ab[1] * ac[2]) + std::abs(ab[2] * ac[1])) * std::abs(ad[0]) +
+                           (std::abs(ab[2] * ac[0]) + std::abs(ab[0] * ac[2])) * std::abs(ad[1]) +
+                           (std::abs(ab[0] * ac[1]) + std::abs(ab[1] * ac[0])) * std::abs(ad[2]);
+  // (7 + 56 eps) eps bounds the error of this evaluation; 1e-15 > 7.8e-16.
+  const double bound = 1e-15 * permanent;
+  if (det > bound)
+  {
+    return 1;
+  }
+  if (det < -bound)
+  {
+    return -1;
+  }
+  if (!std::isfinite(det))
+  {
+    return det > 0.0 ? 1 : (det < 0.0 ? -1 : 0);
+  }
+  // Exact: the differences as two doubles each, then the 6 signed products
+  // of the determinant's expansion, each a sum of 8 products of three doubles.
+  double e[3][3][2];
+  for (unsigned int k = 0; k < 3; ++k)
+  {
+    TwoDifference(b[k], a[k], e[0][k][0], e[0][k][1]);
+    TwoDifference(c[k], a[k], e[1][k][0], e[1][k][1]);
+    TwoDifference(d[k], a[k], e[2][k][0], e[2][k][1]);
+  }
+  ExactSum             sum;
+  static constexpr int permutations[6][3] = { { 0, 1, 2 }, { 1, 2, 0 }, { 2, 0, 1 },
+                                              { 0, 2, 1 }, { 2, 1, 0 }, { 1, 0, 2 } };
+  for (unsigned int p = 0; p < 6; ++p)
+  {
+    const double sign = p < 3 ? 1.0 : -1.0;
+    const int *  s = permutations[p];
+    for (unsigned int i = 0; i < 2; ++i)
+    {
+      for (unsigned int j = 0; j < 2; ++j)
+      {
+        for (unsigned int k = 0; k < 2; ++k)
+        {
+          // det = sum over permutations of sign * ab[s0] ac[s1] ad[s2].
+          sum.AddProduct(sign * e[0][s[0]][i], e[1][s[1]][j], e[2][s[2]][k]);
+        }
+      }
+    }
+  }
+  return sum.Sign();
+}
+
+/** Sign of Orient2D(a, b, c, u, v), exact. */
+inline int
+Orient2DSign(const double * a, const double * b, const double * c, unsigned int u, unsigned int v)
+{
+  const double l = (b[u] - a[u]) * (c[v] - a[v]);
+  const double r = (b[v] - a[v]) * (c[u] - a[u]);
+  const double det = l - r;
+  // (3 + 16 eps) eps bounds the error; 1e-15 > 3.4e-16.
+  const double bound = 1e-15 * (std::abs(l) + std::abs(r));
+  if (det > bound)
+  {
+    return 1;
+  }
+  if (det < -bound)
+  {
+    return -1;
+  }
+  if (!std::isfinite(det))
+  {
+    return det > 0.0 ? 1 : (det < 0.0 ? -1 : 0);
+  }
+  double bu[2], bv[2], cu[2], cv[2];
+  TwoDifference(b[u], a[u], bu[0], bu[1]);
+  TwoDifference(b[v], a[v], bv[0], bv[1]);
+  TwoDifference(c[u], a[u], cu[0], cu[1]);
+  TwoDifference(c[v], a[v], cv[0], cv[1]);
+  ExactSum sum;
+  for (unsigned int i = 0; i < 2; ++i)
+  {
+    for (unsigned int j = 0; j < 2; ++j)
+    {
+      sum.AddProduct(bu[i], cv[j], 1.0);
+      sum.AddProduct(-bv[i], cu[j], 1.0);
+    }
+  }
+  return sum.Sign();
 }
 
 /** Squared distance between the segments [p0, p1] and [q0, q1] (closest
@@ -208,7 +378,8 @@ Orient2D(const double * a, const double * b, const double * c, unsigned int u, u
   return (b[u] - a[u]) * (c[v] - a[v]) - (b[v] - a[v]) * (c[u] - a[u]);
 }
 
-/** Closed 2-D segments [p0, p1] and [q0, q1] (coordinates u, v) meet. */
+/** Closed 2-D segments [p0, p1] and [q0, q1] (coordinates u, v) meet
+ * (exact signs). */
 inline bool
 Segments2DIntersect(const double * p0,
                     const double * p1,
@@ -217,11 +388,11 @@ Segments2DIntersect(const double * p0,
                     unsigned int   u,
                     unsigned int   v)
 {
-  const double o1 = Orient2D(p0, p1, q0, u, v);
-  const double o2 = Orient2D(p0, p1, q1, u, v);
-  const double o3 = Orient2D(q0, q1, p0, u, v);
-  const double o4 = Orient2D(q0, q1, p1, u, v);
-  if (((o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0)) && ((o3 > 0.0 && o4 < 0.0) || (o3 < 0.0 && o4 > 0.0)))
+  const int o1 = Orient2DSign(p0, p1, q0, u, v);
+  const int o2 = Orient2DSign(p0, p1, q1, u, v);
+  const int o3 = Orient2DSign(q0, q1, p0, u, v);
+  const int o4 = Orient2DSign(q0, q1, p1, u, v);
+  if (o1 * o2 < 0 && o3 * o4 < 0)
   {
     return true;
   }
@@ -230,11 +401,11 @@ Segments2DIntersect(const double * p0,
     return std::min(a[u], b[u]) <= p[u] && p[u] <= std::max(a[u], b[u]) && std::min(a[v], b[v]) <= p[v] &&
            p[v] <= std::max(a[v], b[v]);
   };
-  return (o1 == 0.0 && onSegment(p0, p1, q0)) || (o2 == 0.0 && onSegment(p0, p1, q1)) ||
-         (o3 == 0.0 && onSegment(q0, q1, p0)) || (o4 == 0.0 && onSegment(q0, q1, p1));
+  return (o1 == 0 && onSegment(p0, p1, q0)) || (o2 == 0 && onSegment(p0, p1, q1)) ||
+         (o3 == 0 && onSegment(q0, q1, p0)) || (o4 == 0 && onSegment(q0, q1, p1));
 }
 
-/** 2-D point p in the closed triangle (a, b, c). */
+/** 2-D point p in the closed triangle (a, b, c) (exact signs). */
 inline bool
 PointInTriangle2D(const double * p,
                   const double * a,
@@ -243,10 +414,10 @@ PointInTriangle2D(const double * p,
                   unsigned int   u,
                   unsigned int   v)
 {
-  const double o1 = Orient2D(a, b, p, u, v);
-  const double o2 = Orient2D(b, c, p, u, v);
-  const double o3 = Orient2D(c, a, p, u, v);
-  return (o1 >= 0.0 && o2 >= 0.0 && o3 >= 0.0) || (o1 <= 0.0 && o2 <= 0.0 && o3 <= 0.0);
+  const int o1 = Orient2DSign(a, b, p, u, v);
+  const int o2 = Orient2DSign(b, c, p, u, v);
+  const int o3 = Orient2DSign(c, a, p, u, v);
+  return (o1 >= 0 && o2 >= 0 && o3 >= 0) || (o1 <= 0 && o2 <= 0 && o3 <= 0);
 }
 
 /** The axes (u, v) of the coordinate plane onto which a plane of normal n
@@ -296,34 +467,47 @@ CoplanarSegmentTriangle(const double * p, const double * q, const double * const
   return false;
 }
 
+/** The closed segment [p, q] meets the closed triangle b, given the exact
+ * orientations s, t of p and q with respect to b's plane. */
+inline bool
+SegmentMeetsTriangle(const double * p, const double * q, const double * const * b, int s, int t, const double * normalB)
+{
+  if (s * t > 0)
+  {
+    return false;
+  }
+  if (s == 0 && t == 0)
+  {
+    return CoplanarSegmentTriangle(p, q, b, normalB);
+  }
+  // The segment reaches b's plane at one point: the line meets the closed
+  // triangle when its three orientations with b's edges agree.
+  const int o1 = Orient3DSign(p, q, b[0], b[1]);
+  const int o2 = Orient3DSign(p, q, b[1], b[2]);
+  const int o3 = Orient3DSign(p, q, b[2], b[0]);
+  return (o1 >= 0 && o2 >= 0 && o3 >= 0) || (o1 <= 0 && o2 <= 0 && o3 <= 0);
+}
+
+/** The closed segment [p, q] meets the closed triangle b (exact signs). */
+inline bool
+SegmentMeetsTriangle(const double * p, const double * q, const double * const * b)
+{
+  double e1[3], e2[3], nb[3];
+  Subtract(b[1], b[0], e1);
+  Subtract(b[2], b[0], e2);
+  Cross(e1, e2, nb);
+  return SegmentMeetsTriangle(p, q, b, Orient3DSign(b[0], b[1], b[2], p), Orient3DSign(b[0], b[1], b[2], q), nb);
+}
+
 /** The edges of triangle a that meet the closed triangle b, given the
  * orientations sa[k] of a's vertices with respect to b's plane. */
 inline bool
-EdgesOfAMeetB(const double * const * a, const double * const * b, const double * sa, const double * normalB)
+EdgesOfAMeetB(const double * const * a, const double * const * b, const int * sa, const double * normalB)
 {
   for (unsigned int k = 0; k < 3; ++k)
   {
     const unsigned int l = (k + 1) % 3;
-    const double       s = sa[k];
-    const double       t = sa[l];
-    if ((s > 0.0 && t > 0.0) || (s < 0.0 && t < 0.0))
-    {
-      continue;
-    }
-    if (s == 0.0 && t == 0.0)
-    {
-      if (CoplanarSegmentTriangle(a[k], a[l], b, normalB))
-      {
-        return true;
-      }
-      continue;
-    }
-    // The segment reaches b's plane: its line meets the closed triangle when
-    // the three orientations of the line with b's edges agree.
-    const double o1 = Orient3D(a[k], a[l], b[0], b[1]);
-    const double o2 = Orient3D(a[k], a[l], b[1], b[2]);
-    const double o3 = Orient3D(a[k], a[l], b[2], b[0]);
-    if ((o1 >= 0.0 && o2 >= 0.0 && o3 >= 0.0) || (o1 <= 0.0 && o2 <= 0.0 && o3 <= 0.0))
+    if (SegmentMeetsTriangle(a[k], a[l], b, sa[k], sa[l], normalB))
     {
       return true;
     }
@@ -332,27 +516,29 @@ EdgesOfAMeetB(const double * const * a, const double * const * b, const double *
 }
 
 /** Whether the closed triangles a and b (arrays of 3 points) share a point:
- * crossing, touching or coplanar overlap. Signs of plain double determinants:
- * exact for well-separated or clearly crossing triangles, uncertain only
- * within rounding of a contact. */
+ * crossing, touching or coplanar overlap. Exact: the decisions are signs of
+ * orientation determinants (Orient3DSign(), Orient2DSign()) and comparisons
+ * of coordinates, so that nearly coplanar triangles (the children of one
+ * flat patch of a subdivided mesh, 1e-17 out of each other's planes) are
+ * not called crossing by rounding. */
 inline bool
 TrianglesIntersect(const double * const * a, const double * const * b)
 {
-  double sb[3];
-  double sa[3];
+  int sb[3];
+  int sa[3];
   for (unsigned int k = 0; k < 3; ++k)
   {
-    sb[k] = Orient3D(a[0], a[1], a[2], b[k]);
+    sb[k] = Orient3DSign(a[0], a[1], a[2], b[k]);
   }
-  if ((sb[0] > 0.0 && sb[1] > 0.0 && sb[2] > 0.0) || (sb[0] < 0.0 && sb[1] < 0.0 && sb[2] < 0.0))
+  if ((sb[0] > 0 && sb[1] > 0 && sb[2] > 0) || (sb[0] < 0 && sb[1] < 0 && sb[2] < 0))
   {
     return false;
   }
   for (unsigned int k = 0; k < 3; ++k)
   {
-    sa[k] = Orient3D(b[0], b[1], b[2], a[k]);
+    sa[k] = Orient3DSign(b[0], b[1], b[2], a[k]);
   }
-  if ((sa[0] > 0.0 && sa[1] > 0.0 && sa[2] > 0.0) || (sa[0] < 0.0 && sa[1] < 0.0 && sa[2] < 0.0))
+  if ((sa[0] > 0 && sa[1] > 0 && sa[2] > 0) || (sa[0] < 0 && sa[1] < 0 && sa[2] < 0))
   {
     return false;
   }
@@ -363,7 +549,7 @@ TrianglesIntersect(const double * const * a, const double * const * b)
   Subtract(b[1], b[0], e1);
   Subtract(b[2], b[0], e2);
   Cross(e1, e2, nb);
-  if (sb[0] == 0.0 && sb[1] == 0.0 && sb[2] == 0.0)
+  if (sb[0] == 0 && sb[1] == 0 && sb[2] == 0)
   {
     // Coplanar: an edge of one meets the other, or one contains the other.
     unsigned int u = 0;
@@ -408,6 +594,42 @@ TriangleDistance(const double * const * a, const double * const * b)
     d2 = std::min(d2, PointTriangleDistanceSquared(b[k], a[0], a[1], a[2]));
   }
   return std::sqrt(d2);
+}
+
+/** Distance between the closed segment [p, q] and the closed triangle b:
+ * 0 when they meet (exact test), otherwise the smallest of the distances of
+ * p and q to b and of the segment to b's edges. */
+inline double
+SegmentTriangleDistance(const double * p, const double * q, const double * const * b)
+{
+  if (SegmentMeetsTriangle(p, q, b))
+  {
+    return 0.0;
+  }
+  double d2 =
+    std::min(PointTriangleDistanceSquared(p, b[0], b[1], b[2]), PointTriangleDistanceSquared(q, b[0], b[1], b[2]));
+  for (unsigned int k = 0; k < 3; ++k)
+  {
+    d2 = std::min(d2, SegmentSegmentDistanceSquared(p, q, b[k], b[(k + 1) % 3]));
+  }
+  return std::sqrt(d2);
+}
+
+/** Gap of two triangles that share exactly one vertex, a[i] == b[j]: the
+ * smaller of the distances between the edge of each opposite the shared
+ * vertex and the other triangle. It is 0 exactly when the triangles meet
+ * elsewhere than at the shared vertex: their intersection is convex and
+ * holds the shared vertex v, and when it holds another point its farthest
+ * point from v along that direction lies on one of these two edges. */
+inline double
+SharedVertexGap(const double * const * a, unsigned int i, const double * const * b, unsigned int j)
+{
+  const double ga = SegmentTriangleDistance(a[(i + 1) % 3], a[(i + 2) % 3], b);
+  if (ga == 0.0)
+  {
+    return 0.0;
+  }
+  return std::min(ga, SegmentTriangleDistance(b[(j + 1) % 3], b[(j + 2) % 3], a));
 }
 
 /** Triangles t and u (3 vertex indices each) share a vertex. */
@@ -513,6 +735,11 @@ public:
         }
       });
     }
+    m_EntryBoxes.resize(6 * m_Entries.size());
+    for (SizeValueType e = 0; e < m_Entries.size(); ++e)
+    {
+      std::copy(boxes + 6 * m_Entries[e], boxes + 6 * m_Entries[e] + 6, m_EntryBoxes.data() + 6 * e);
+    }
   }
 
   /** Calls f(u) for every box u != t that overlaps box t, once each. */
@@ -590,11 +817,64 @@ public:
     return m_Entries.size();
   }
 
+  SizeValueType
+  GetNumberOfBuckets() const
+  {
+    return m_BucketOffsets.empty() ? 0 : m_BucketOffsets.size() - 1;
+  }
+
+  /** Calls f(t, u), t < u, for every pair of overlapping boxes whose
+   * intersection's lower corner lies in a cell of the buckets [begin, end):
+   * over all buckets, every overlapping pair once. The pairs of one bucket
+   * are enumerated from its entries, with the boxes copied in bucket order
+   * (read in sequence). */
+  template <typename TFunction>
+  void
+  ForEachPair(SizeValueType begin, SizeValueType end, TFunction && f) const
+  {
+    for (SizeValueType bucket = begin; bucket < end; ++bucket)
+    {
+      const SizeValueType first = m_BucketOffsets[bucket];
+      const SizeValueType last = m_BucketOffsets[bucket + 1];
+      for (SizeValueType i = first; i + 1 < last; ++i)
+      {
+        const float * a = m_EntryBoxes.data() + 6 * i;
+        for (SizeValueType j = i + 1; j < last; ++j)
+        {
+          const float * b = m_EntryBoxes.data() + 6 * j;
+          if (a[0] > b[3] || b[0] > a[3] || a[1] > b[4] || b[1] > a[4] || a[2] > b[5] || b[2] > a[5])
+          {
+            continue;
+          }
+          // The cell of the lower corner of the boxes' intersection: the
+          // pair belongs to this bucket when that cell hashes to it.
+          if (this->Bucket(this->CellOf(std::max(a[0], b[0]), 0),
+                           this->CellOf(std::max(a[1], b[1]), 1),
+                           this->CellOf(std::max(a[2], b[2]), 2)) != bucket)
+          {
+            continue;
+          }
+          const SizeValueType t = m_Entries[i];
+          const SizeValueType u = m_Entries[j];
+          if (t < u)
+          {
+            f(t, u);
+          }
+          else
+          {
+            f(u, t);
+          }
+        }
+      }
+    }
+  }
+
   void
   Clear()
   {
     std::vector<SizeValueType>().swap(m_BucketOffsets);
     std::vector<uint32_t>().swap(m_Entries);
+    std::vector<float>().swap(m_EntryBoxes);
     m_Boxes = nullptr;
     m_NumberOfBoxes = 0;
   }
@@ -635,7 +915,35 @@ private:
   uint64_t                   m_Mask{ 0 };
   std::vector<SizeValueType> m_BucketOffsets;
   std::vector<uint32_t>      m_Entries;
+  std::vector<float>         m_EntryBoxes; // the boxes of m_Entries, in its order
 };
+
+/** The float next below f (std::nextafter toward -infinity, inline: the
+ * library call was 5 % of a step of the index). */
+inline float
+NextFloatDown(float f)
+{
+  if (!(f == f) || f == -std::numeric_limits<float>::infinity())
+  {
+    return f;
+  }
+  if (f == 0.0f)
+  {
+    return -std::numeric_limits<float>::denorm_min();
+  }
+  uint32_t bits;
+  std::memcpy(&bits, &f, sizeof(bits));
+  bits = f > 0.0f ? bits - 1 : bits + 1;
+  std::memcpy(&f, &bits, sizeof(bits));
+  return f;
+}
+
+/** The float next above f (std::nextafter toward +infinity). */
+inline float
+NextFloatUp(float f)
+{
+  return -NextFloatDown(-f);
+}
 
 /** Writes the float box of the points (3 doubles each) given, widened by
  * \a margin and rounded outward. */
@@ -650,11 +958,11 @@ StoreBox(const double * lower, const double * upper, double margin, float * box)
     float        fhi = static_cast<float>(hi);
     if (static_cast<double>(flo) > lo)
     {
-      flo = std::nextafter(flo, -std::numeric_limits<float>::infinity());
+      flo = NextFloatDown(flo);
     }
     if (static_cast<double>(fhi) < hi)
     {
-      fhi = std::nextafter(fhi, std::numeric_limits<float>::infinity());
+      fhi = NextFloatUp(fhi);
     }
     box[k] = flo;
     box[3 + k] = fhi;
@@ -670,7 +978,16 @@ StoreBox(const double * lower, const double * upper, double margin, float * box)
  *
  * Works on flat arrays: point coordinates (3 doubles a point, physical
  * units) and triangles (3 point indices each). Pairs of triangles that share
- * a vertex are never tested (they touch by construction).
+ * an edge are not tested (they touch by construction). Pairs that share
+ * exactly one vertex v (two triangles of one fan, "shared pairs") must not
+ * fold into each other: their gap, the distance between the edge of each
+ * opposite v and the other triangle (SharedVertexGap(), 0 exactly when they
+ * meet elsewhere than at v), may not fall below the contact distance and
+ * below its value at x; they are kept in a list of their own, built from
+ * the connectivity, with their gaps at the reference (exact, at each
+ * rebuild) in their triangles' clearances. The intersection predicates use
+ * exact signs of the orientation determinants (Orient3DSign()), so that the
+ * nearly coplanar triangles of a flat patch are not called crossing.
  *
  * Constrain() takes the current positions x (a state in which no pair
  * intersects) and the proposed next positions y, and modifies y. A pair
@@ -783,6 +1100,46 @@ public:
         m_VertexTriangles[fill[m_Triangles[3 * t + k]]++] = static_cast<IndexType>(t);
       }
     }
+    // The pairs sharing exactly one vertex (in one fan, not across an
+    // edge): each once, t < u, and per triangle the pairs it is in.
+    m_SharedPairs.clear();
+    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+    {
+      const IndexType * vt = m_Triangles.data() + 3 * t;
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        for (SizeValueType f = m_VertexTriangleOffsets[vt[k]]; f < m_VertexTriangleOffsets[vt[k] + 1]; ++f)
+        {
+          const IndexType u = m_VertexTriangles[f];
+          if (u > t && SharedVertices(vt, m_Triangles.data() + 3 * u) == 1)
+          {
+            m_SharedPairs.push_back(static_cast<IndexType>(t));
+            m_SharedPairs.push_back(u);
+          }
+        }
+      }
+    }
+    const SizeValueType numberOfSharedPairs = m_SharedPairs.size() / 2;
+    m_SharedOffsets.assign(numberOfTriangles + 1, 0);
+    for (const IndexType t : m_SharedPairs)
+    {
+      ++m_SharedOffsets[t + 1];
+    }
+    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+    {
+      m_SharedOffsets[t + 1] += m_SharedOffsets[t];
+    }
+    m_SharedOfTriangle.resize(m_SharedPairs.size());
+    {
+      std::vector<IndexType> next(m_SharedOffsets.begin(), m_SharedOffsets.end() - 1);
+      for (SizeValueType q = 0; q < numberOfSharedPairs; ++q)
+      {
+        m_SharedOfTriangle[next[m_SharedPairs[2 * q]]++] = static_cast<IndexType>(q);
+        m_SharedOfTriangle[next[m_SharedPairs[2 * q + 1]]++] = static_cast<IndexType>(q);
+      }
+    }
+    m_SharedGaps.assign(numberOfSharedPairs, 0.0f);
+    m_SharedExact.assign(numberOfSharedPairs, 0);
     m_HasSurface = true;
     this->Invalidate();
   }
@@ -996,6 +1353,24 @@ public:
                                static_cast<IndexType>(std::max<SizeValueType>(t, u)));
             }
           }
+          for (IndexType k = m_SharedOffsets[t]; k < m_SharedOffsets[t + 1]; ++k)
+          {
+            const IndexType q = m_SharedOfTriangle[k];
+            const IndexType u = this->OtherOfShared(q, t);
+            if (m_Active[u] && u < t)
+            {
+              continue;
+            }
+            if (this->SharedPairClear(q, LargestDistance(bt, m_TriangleDelta.data() + 6 * u)))
+            {
+              continue;
+            }
+            if (this->ViolatesShared(q, x, y, m_ContactDistance))
+            {
+              out.emplace_back(std::min<IndexType>(static_cast<IndexType>(t), u),
+                               std::max<IndexType>(static_cast<IndexType>(t), u));
+            }
+          }
         }
         tested[begin / 1024] = count;
       });
@@ -1012,8 +1387,21 @@ public:
       for (const IndexType t : m_Large)
       {
         const float * bt = m_TriangleDelta.data() + 6 * t;
-        const double  reach = LargestDistance(bt, m_GlobalDelta) + d;
-        double        lo[3], hi[3];
+        for (IndexType k = m_SharedOffsets[t]; k < m_SharedOffsets[t + 1]; ++k)
+        {
+          const IndexType q = m_SharedOfTriangle[k];
+          const IndexType u = this->OtherOfShared(q, t);
+          if ((m_IsLarge[u] && u < t) || this->SharedPairClear(q, LargestDistance(bt, m_TriangleDelta.data() + 6 * u)))
+          {
+            continue;
+          }
+          if (this->ViolatesShared(q, x, y, m_ContactDistance))
+          {
+            violating.emplace_back(std::min(t, u), std::max(t, u));
+          }
+        }
+        const double reach = LargestDistance(bt, m_GlobalDelta) + d;
+        double       lo[3], hi[3];
         TriangleBox(m_Reference.data(), m_Triangles.data() + 3 * t, lo, hi);
         float query[6];
         SurfaceCollisionDetail::StoreBox(lo, hi, reach, query);
@@ -1060,15 +1448,35 @@ public:
           }
         });
       }
+      for (SizeValueType q = 0; q < m_SharedGaps.size(); ++q)
+      {
+        if (this->ViolatesShared(q, x, y, m_ContactDistance))
+        {
+          violating.emplace_back(m_SharedPairs[2 * q], m_SharedPairs[2 * q + 1]);
+        }
+      }
     }
 
     // Reduce the displacements of the violating pairs' points, test the
     // pairs of the modified triangles again, until none violates.
+    // When the index bounds every state between x and y (the displacement
+    // boxes of x - r and y - r together), the modified triangles are tested
+    // against their candidate and shared pairs (and, when there are large
+    // triangles, the reference grid) instead of a grid of every triangle's
+    // box swept from x to y.
     std::vector<IndexType> touched;
     std::vector<IndexType> triangles;
+    bool                   sweptBounded = false;
+    if (!violating.empty() && !sweptGridBuilt)
+    {
+      sweptBounded = this->Bound(y, parallel, x) == BoundStatus::Bounded;
+    }
     while (!violating.empty())
     {
-      buildSweptGrid();
+      if (!sweptBounded)
+      {
+        buildSweptGrid();
+      }
       std::sort(violating.begin(), violating.end());
       violating.erase(std::unique(violating.begin(), violating.end()), violating.end());
       result.violations += violating.size();
@@ -1112,17 +1520,34 @@ public:
       violating.clear();
       for (const IndexType t : triangles)
       {
-        m_SweptGrid.ForEachOverlap(t, [&](SizeValueType u) {
-          if (SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
-          {
-            return;
-          }
+        const auto test = [&](SizeValueType u) {
           if (this->Violates(t, u, x, y, d))
           {
             violating.emplace_back(std::min<IndexType>(t, static_cast<IndexType>(u)),
                                    std::max<IndexType>(t, static_cast<IndexType>(u)));
           }
-        });
+        };
+        if (sweptBounded)
+        {
+          this->ForEachBoundedPartner(t, d, test);
+        }
+        else
+        {
+          m_SweptGrid.ForEachOverlap(t, [&](SizeValueType u) {
+            if (!SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
+            {
+              test(u);
+            }
+          });
+        }
+        for (IndexType k = m_SharedOffsets[t]; k < m_SharedOffsets[t + 1]; ++k)
+        {
+          const IndexType q = m_SharedOfTriangle[k];
+          if (this->ViolatesShared(q, x, y, m_ContactDistance))
+          {
+            violating.emplace_back(m_SharedPairs[2 * q], m_SharedPairs[2 * q + 1]);
+          }
+        }
       }
     }
     for (const IndexType i : m_ModifiedPoints)
@@ -1323,6 +1748,185 @@ private:
     }
   }
 
+  /** Number of vertices triangles t and u (3 indices each) share. */
+  static unsigned int
+  SharedVertices(const IndexType * t, const IndexType * u)
+  {
+    unsigned int count = 0;
+    for (unsigned int i = 0; i < 3; ++i)
+    {
+      count += (t[i] == u[0]) + (t[i] == u[1]) + (t[i] == u[2]);
+    }
+    return count;
+  }
+
+  /** Calls f(u) for every triangle u sharing no vertex with t that may
+   * come within d of it while the displacements since the reference stay in
+   * the boxes of the last Bound() (which held): t's candidates whose pair
+   * bound does not clear them and, when there are large triangles, the pairs
+   * of t with a large triangle found in the reference grid. Other pairs are
+   * kept apart by the cells' bounds. */
+  template <typename TFunction>
+  void
+  ForEachBoundedPartner(SizeValueType t, double d, TFunction && f)
+  {
+    const float * bt = m_TriangleDelta.data() + 6 * t;
+    for (SizeValueType c = m_CandidateOffsets[t]; c < m_CandidateOffsets[t + 1]; ++c)
+    {
+      const IndexType u = m_Candidates[c];
+      if (LargestDistance(bt, m_TriangleDelta.data() + 6 * u) < static_cast<double>(m_CandidateGaps[c]) - d)
+      {
+        continue;
+      }
+      f(u);
+    }
+    if (m_Large.empty())
+    {
+      return;
+    }
+    const double reach = LargestDistance(bt, m_GlobalDelta) + d;
+    double       lo[3], hi[3];
+    TriangleBox(m_Reference.data(), m_Triangles.data() + 3 * t, lo, hi);
+    float query[6];
+    SurfaceCollisionDetail::StoreBox(lo, hi, reach, query);
+    m_ReferenceGrid.ForEachOverlapOfBox(query, t, [&](SizeValueType u) {
+      if ((!m_IsLarge[t] && !m_IsLarge[u]) ||
+          SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
+      {
+        return;
+      }
+      f(u);
+    });
+  }
+
+  /** The triangle of shared pair q other than t. */
+  IndexType
+  OtherOfShared(SizeValueType q, SizeValueType t) const
+  {
+    return m_SharedPairs[2 * q] == t ? m_SharedPairs[2 * q + 1] : m_SharedPairs[2 * q];
+  }
+
+  /** SharedVertexGap() of the shared pair q at the positions x. */
+  double
+  SharedGap(SizeValueType q, const double * x) const
+  {
+    const IndexType * vt = m_Triangles.data() + 3 * m_SharedPairs[2 * q];
+    const IndexType * vu = m_Triangles.data() + 3 * m_SharedPairs[2 * q + 1];
+    unsigned int      i = 0;
+    unsigned int      j = 0;
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      for (unsigned int l = 0; l < 3; ++l)
+      {
+        if (vt[k] == vu[l])
+        {
+          i = k;
+          j = l;
+        }
+      }
+    }
+    const double * a[3] = { x + 3 * vt[0], x + 3 * vt[1], x + 3 * vt[2] };
+    const double * b[3] = { x + 3 * vu[0], x + 3 * vu[1], x + 3 * vu[2] };
+    return SurfaceCollisionDetail::SharedVertexGap(a, i, b, j);
+  }
+
+  /** A lower bound of SharedGap(q, x), cheap: the largest separation of
+   * the far edge of one triangle and the other triangle along a few axes
+   * (the line between the far edges' midpoints, the triangles' normals), the
+   * smaller of the two. */
+  double
+  SharedGapLowerBound(SizeValueType q, const double * x) const
+  {
+    const IndexType * vt = m_Triangles.data() + 3 * m_SharedPairs[2 * q];
+    const IndexType * vu = m_Triangles.data() + 3 * m_SharedPairs[2 * q + 1];
+    unsigned int      i = 0;
+    unsigned int      j = 0;
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      for (unsigned int l = 0; l < 3; ++l)
+      {
+        if (vt[k] == vu[l])
+        {
+          i = k;
+          j = l;
+        }
+      }
+    }
+    using namespace SurfaceCollisionDetail;
+    const double * v = x + 3 * vt[i];
+    double         p[3], q1[3], r[3], s[3];
+    Subtract(x + 3 * vt[(i + 1) % 3], v, p);
+    Subtract(x + 3 * vt[(i + 2) % 3], v, q1);
+    Subtract(x + 3 * vu[(j + 1) % 3], v, r);
+    Subtract(x + 3 * vu[(j + 2) % 3], v, s);
+    // The separation of the far edge {e0, e1} of one triangle from the
+    // other triangle {0, f0, f1} (coordinates relative to the shared vertex):
+    // the largest along the other triangle's normal, its two edges' normals
+    // in its plane at the shared vertex (pointing away from it), and the
+    // line from its far edge's midpoint to the far edge's midpoint.
+    const auto bound = [](const double * e0, const double * e1, const double * f0, const double * f1) {
+      double axes[4][3];
+      Cross(f0, f1, axes[0]);
+      Cross(f0, axes[0], axes[1]);
+      Cross(axes[0], f1, axes[2]);
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        axes[3][k] = (e0[k] + e1[k]) - (f0[k] + f1[k]);
+      }
+      double best = 0.0;
+      for (const auto & axis : axes)
+      {
+        const double length = std::sqrt(Dot(axis, axis));
+        if (!(length > 0.0))
+        {
+          continue;
+        }
+        const double e[2] = { Dot(axis, e0), Dot(axis, e1) };
+        const double f[2] = { Dot(axis, f0), Dot(axis, f1) };
+        const double above = std::min(e[0], e[1]) - std::max({ 0.0, f[0], f[1] });
+        const double below = std::min({ 0.0, f[0], f[1] }) - std::max(e[0], e[1]);
+        best = std::max(best, std::max(above, below) / length);
+      }
+      return best;
+    };
+    const double first = bound(p, q1, r, s);
+    const double second = bound(r, s, p, q1);
+    // Rounding of the differences and projections: a margin relative to the
+    // coordinates' magnitude.
+    const double scale = std::sqrt(std::max({ Dot(p, p), Dot(q1, q1), Dot(r, r), Dot(s, s) })) + std::abs(v[0]) +
+                         std::abs(v[1]) + std::abs(v[2]);
+    return std::max(0.0, std::min(first, second) - 1e-12 * scale);
+  }
+
+  /** Shared pair q cannot violate while the relative motion of its
+   * triangles is below \a motion: its gap at the reference less the
+   * contact distance is above the motion (with the exact gap computed once
+   * per rebuild when the bound does not tell). */
+  bool
+  SharedPairClear(SizeValueType q, double motion)
+  {
+    if (motion < static_cast<double>(m_SharedGaps[q]) - m_ContactDistance)
+    {
+      return true;
+    }
+    if (m_SharedExact[q])
+    {
+      return false;
+    }
+    m_SharedGaps[q] = RoundDown(this->SharedGap(q, m_Reference.data()));
+    m_SharedExact[q] = 1;
+    return motion < static_cast<double>(m_SharedGaps[q]) - m_ContactDistance;
+  }
+
+  /** Shared pair q violates at y: its gap is below the contact distance c
+   * and below its gap at x (the two triangles fold into each other). */
+  bool
+  ViolatesShared(SizeValueType q, const double * x, const double * y, double c) const
+  {
+    const double next = this->SharedGap(q, y);
+    return next < c && next < this->SharedGap(q, x);
+  }
+
   /** Pair (t, u) violates at y (see the class documentation); d > 0. */
   bool
   Violates(SizeValueType t, SizeValueType u, const double * x, const double * y, double d) const
@@ -1364,7 +1968,7 @@ private:
   RoundDown(double m)
   {
     const float f = static_cast<float>(m);
-    return static_cast<double>(f) <= m ? f : std::nextafter(f, -std::numeric_limits<float>::infinity());
+    return static_cast<double>(f) <= m ? f : SurfaceCollisionDetail::NextFloatDown(f);
   }
 
   /** Rebuilds the index at the reference positions x (see the class
@@ -1409,8 +2013,9 @@ private:
         Sphere(x, m_Triangles.data() + 3 * t, m_Spheres.data() + 4 * t);
       }
     });
-    // The cells are sized for the triangles up to the 99th percentile of
-    // the radii; the larger ("large triangles") are tested at every step.
+    // The cells are sized for the triangles up to 1.25 times the 99th
+    // percentile of the radii; the larger ("large triangles") are tested at
+    // every step.
     double typicalRadius = 0.0;
     {
       std::vector<double> radii(numberOfTriangles);
@@ -1420,7 +2025,18 @@ private:
       }
       const auto q = radii.begin() + static_cast<std::ptrdiff_t>((99 * (numberOfTriangles - 1)) / 100);
       std::nth_element(radii.begin(), q, radii.end());
+      // The cells hold every triangle up to 1.25 times the 99th percentile
+      // (on an even mesh, all of them: the large triangles' grid queries
+      // at every step were a fifth of a step of the index).
+      const double limit = 1.25 * *q;
       typicalRadius = *q;
+      for (const double r : radii)
+      {
+        if (r <= limit)
+        {
+          typicalRadius = std::max(typicalRadius, r);
+        }
+      }
     }
 
     m_Large.clear();
@@ -1454,17 +2070,19 @@ private:
       IndexType u;
       float     gap;
     };
-    const SizeValueType            blocks = (numberOfTriangles + 1023) / 1024;
+    // The overlapping pairs of boxes, enumerated bucket by bucket (each
+    // pair once, the boxes read in sequence).
+    const SizeValueType            buckets = grid.GetNumberOfBuckets();
+    const SizeValueType            blocks = (buckets + 1023) / 1024;
     std::vector<std::vector<Pair>> pairs(blocks);
-    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+    parallel(buckets, [&](SizeValueType begin, SizeValueType end) {
       auto & out = pairs[begin / 1024];
-      for (SizeValueType t = begin; t < end; ++t)
-      {
-        const IndexType * vt = m_Triangles.data() + 3 * t;
-        const double *    st = m_Spheres.data() + 4 * t;
-        grid.ForEachOverlap(t, [&](SizeValueType u) {
+      grid.ForEachPair(begin, end, [&](SizeValueType t, SizeValueType u) {
+        {
+          const IndexType * vt = m_Triangles.data() + 3 * t;
+          const double *    st = m_Spheres.data() + 4 * t;
           const IndexType * vu = m_Triangles.data() + 3 * u;
-          if (u < t || SurfaceCollisionDetail::ShareVertex(vt, vu))
+          if (SurfaceCollisionDetail::ShareVertex(vt, vu))
           {
             return;
           }
@@ -1475,7 +2093,13 @@ private:
           const double * su = m_Spheres.data() + 4 * u;
           double         e[3];
           SurfaceCollisionDetail::Subtract(su, st, e);
-          const double centres = std::sqrt(SurfaceCollisionDetail::Dot(e, e));
+          const double centres2 = SurfaceCollisionDetail::Dot(e, e);
+          const double reach = radius + st[3] + su[3];
+          if (centres2 >= reach * reach * (1.0 + 1e-12))
+          {
+            return; // the spheres' gap alone is beyond the radius
+          }
+          const double centres = std::sqrt(centres2);
           double       gap = centres - st[3] - su[3];
           if (centres > 0.0)
           {
@@ -1493,8 +2117,8 @@ private:
             return;
           }
           out.push_back({ static_cast<IndexType>(t), static_cast<IndexType>(u), RoundDown(std::max(gap, 0.0)) });
-        });
-      }
+        }
+      });
     });
     m_CandidateOffsets.assign(numberOfTriangles + 1, 0);
     for (const auto & block : pairs)
@@ -1535,6 +2159,25 @@ private:
           smallest = std::min(smallest, static_cast<double>(m_CandidateGaps[c]));
         }
         m_Clearance[t] = RoundDown(smallest - d);
+      }
+    });
+    // The pairs sharing one vertex: their gaps at the reference (exact), and
+    // the clearance of their triangles against the contact distance.
+    parallel(m_SharedGaps.size(), [&](SizeValueType begin, SizeValueType end) {
+      for (SizeValueType q = begin; q < end; ++q)
+      {
+        m_SharedExact[q] = 0;
+        m_SharedGaps[q] = RoundDown(this->SharedGapLowerBound(q, x));
+      }
+    });
+    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+      for (SizeValueType t = begin; t < end; ++t)
+      {
+        for (IndexType k = m_SharedOffsets[t]; k < m_SharedOffsets[t + 1]; ++k)
+        {
+          m_Clearance[t] = std::min(
+            m_Clearance[t], RoundDown(static_cast<double>(m_SharedGaps[m_SharedOfTriangle[k]]) - m_ContactDistance));
+        }
       }
     });
 
@@ -1729,7 +2372,7 @@ private:
    * whose rho reaches their clearance. */
   template <typename TParallel>
   BoundStatus
-  Bound(const double * y, TParallel && parallel)
+  Bound(const double * y, TParallel && parallel, const double * x = nullptr)
   {
     const SizeValueType n = m_NumberOfPoints;
     const double        d = std::max(m_MinimumDistance, m_ContactDistance);
@@ -1741,9 +2384,17 @@ private:
         float * box = m_VertexDelta.data() + 6 * i;
         for (unsigned int k = 0; k < 3; ++k)
         {
-          const double delta = y[3 * i + k] - m_Reference[3 * i + k];
-          blockFinite = blockFinite && std::isfinite(delta);
-          box[k] = RoundDown(delta);
+          double delta = y[3 * i + k] - m_Reference[3 * i + k];
+          double low = delta;
+          if (x != nullptr)
+          {
+            // The box of x - r and y - r: every state between x and y.
+            const double other = x[3 * i + k] - m_Reference[3 * i + k];
+            low = std::min(delta, other);
+            delta = std::max(delta, other);
+          }
+          blockFinite = blockFinite && std::isfinite(delta) && std::isfinite(low);
+          box[k] = RoundDown(low);
           box[3 + k] = RoundUp(delta);
         }
       }
@@ -1900,7 +2551,7 @@ private:
   RoundUp(double m)
   {
     const float f = static_cast<float>(m);
-    return static_cast<double>(f) >= m ? f : std::nextafter(f, std::numeric_limits<float>::infinity());
+    return static_cast<double>(f) >= m ? f : SurfaceCollisionDetail::NextFloatUp(f);
   }
 
   /** Bounding sphere of a triangle: centroid c[0..2], radius c[3] (the
@@ -1928,6 +2579,11 @@ private:
   std::vector<IndexType>     m_Triangles;
   std::vector<SizeValueType> m_VertexTriangleOffsets;
   std::vector<IndexType>     m_VertexTriangles;
+  std::vector<IndexType>     m_SharedPairs;      // pairs sharing exactly one vertex: t, u (t < u)
+  std::vector<IndexType>     m_SharedOffsets;    // triangle -> range of m_SharedOfTriangle
+  std::vector<IndexType>     m_SharedOfTriangle; // the shared pairs each triangle is in
+  std::vector<float>         m_SharedGaps;       // per shared pair: a lower bound of its gap at the reference
+  std::vector<uint8_t>       m_SharedExact;      // per shared pair: the bound is the exact gap
 
   // The index (see the class documentation).
   bool                            m_IndexValid{ false };

@@ -34,6 +34,7 @@
 
 #include <array>
 #include <cmath>
+#include <map>
 #include <random>
 #include <vector>
 
@@ -389,6 +390,130 @@ TEST(SurfaceCollision, SkewEdgesGiveTheLineDistance)
   const Triangle b = { { 0, -1, h }, { 0, 1, h }, { 0, 0, h + 2 } };
   EXPECT_FALSE(Intersect(a, b));
   EXPECT_EQ(Distance(a, b), h);
+}
+
+TEST(SurfaceCollision, NearlyCoplanarTrianglesOfAFlatPatchDoNotIntersect)
+{
+  // Two triangles of edmodel's refined brain mesh (ch2bet, --init-sphere
+  // 0,-18,10,40): children of one flat patch that no step had moved, 1e-17
+  // out of each other's planes and some 0.1 mm apart in them. The plain
+  // double determinants called them crossing (the filter then refused the
+  // next level's input); exact signs do not.
+  const Triangle a = { { 0.53191228781025468, 38.184761268182463, -9.2977485889955709 },
+                       { 0.52962394388423373, 38.287848613370436, -8.9297869451913314 },
+                       { 0.56356014829611922, 38.411527656823552, -9.7360562562974078 } };
+  const Triangle b = { { 0.52733559995821278, 38.390935958558408, -8.561825301387092 },
+                       { 0.52504725603219182, 38.494023303746381, -8.1938636575828525 },
+                       { 0.55898346044407732, 38.617702347199497, -9.0001329686889289 } };
+  EXPECT_FALSE(Intersect(a, b));
+  EXPECT_GT(Distance(a, b), 0.05);
+
+  // A flat patch in a tilted plane (6 x 6 squares, 72 triangles), split
+  // twice at the midpoints of its edges (each triangle into four, as
+  // edmodel refines): its triangles meet only at shared vertices and edges,
+  // so no pair sharing no vertex intersects (the plain determinants found 1
+  // and 5 pairs after the first and second split).
+  const double          o[3] = { 0.52533177940643472, 39.766135981018408, -13.271738695729825 };
+  const double          u[3] = { 0.0032902541, -0.7906873565, 1.9869950767 };
+  const double          v[3] = { 0.0665859750, -0.3371546, 1.1103799 };
+  const unsigned int    m = 6;
+  std::vector<double>   x;
+  std::vector<uint32_t> triangles;
+  for (unsigned int j = 0; j <= m; ++j)
+  {
+    for (unsigned int i = 0; i <= m; ++i)
+    {
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        x.push_back(o[k] + 0.37 * i * u[k] + 0.41 * j * v[k]);
+      }
+    }
+  }
+  for (unsigned int j = 0; j < m; ++j)
+  {
+    for (unsigned int i = 0; i < m; ++i)
+    {
+      const uint32_t p = j * (m + 1) + i;
+      triangles.insert(triangles.end(), { p, p + 1, p + m + 2, p, p + m + 2, p + m + 1 });
+    }
+  }
+  for (unsigned int level = 0; level < 3; ++level)
+  {
+    EXPECT_EQ(itk::SurfaceCollision::CountSelfIntersections(x.data(), triangles.data(), triangles.size() / 3), 0u)
+      << "after " << level << " splits";
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints;
+    const auto                                        midpoint = [&](uint32_t p, uint32_t q) {
+      const auto key = std::make_pair(std::min(p, q), std::max(p, q));
+      const auto found = midpoints.find(key);
+      if (found != midpoints.end())
+      {
+        return found->second;
+      }
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        x.push_back(0.5 * (x[3 * p + k] + x[3 * q + k]));
+      }
+      const auto id = static_cast<uint32_t>(x.size() / 3 - 1);
+      midpoints.emplace(key, id);
+      return id;
+    };
+    std::vector<uint32_t> split;
+    for (std::size_t t = 0; t < triangles.size() / 3; ++t)
+    {
+      const uint32_t p = triangles[3 * t], q = triangles[3 * t + 1], r = triangles[3 * t + 2];
+      const uint32_t pq = midpoint(p, q), qr = midpoint(q, r), rp = midpoint(r, p);
+      split.insert(split.end(), { p, pq, rp, pq, q, qr, rp, qr, r, pq, qr, rp });
+    }
+    triangles.swap(split);
+  }
+}
+
+TEST(SurfaceCollision, TrianglesSharingAVertexDoNotFoldThroughEachOther)
+{
+  // Two triangles of one fan, sharing only the vertex v = 0: a in the plane
+  // z = 0, b above it. The step moves one far vertex of b below the plane,
+  // so that b would cut through a along a segment from v (b's far edge
+  // crossing a at (0.35, 0.35, 0)). Such pairs are not tested as
+  // "triangles sharing no vertex", but they must not pass through each
+  // other: Constrain() reduces the step until b's far edge stays clear of a.
+  std::vector<double>         x = { 0, 0, 0, 1, 0, 0, 0, 1, 0, 0.5, 0.2, 1, 0.2, 0.5, 1 };
+  const std::vector<uint32_t> triangles = { 0, 1, 2, 0, 3, 4 };
+  std::vector<double>         y = x;
+  y[3 * 3 + 2] = -1.0;
+  const Vec  v0{ 0, 0, 0 }, a1{ 1, 0, 0 }, a2{ 0, 1, 0 };
+  const auto farEdgeHitsA = [&](const std::vector<double> & p) {
+    return SegmentHitsTriangle(Vec{ p[9], p[10], p[11] }, Vec{ p[12], p[13], p[14] }, v0, a1, a2);
+  };
+  ASSERT_FALSE(farEdgeHitsA(x));
+  ASSERT_TRUE(farEdgeHitsA(y)) << "unconstrained, b cuts through a";
+
+  itk::SurfaceCollision collision;
+  collision.SetSurface(5, triangles.data(), 2);
+  const auto result = collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1);
+  EXPECT_GT(result.violations, 0u);
+  EXPECT_FALSE(farEdgeHitsA(y)) << "b's far vertex at z = " << y[11];
+  // The known answer: b's far edge crosses the plane z = 0 inside a for
+  // every lowering of the vertex below z = 0, so the halvings go on until
+  // its displacement is a quarter (z = 0.5), then zero: z = 1 - 2 / 4 = 0.5
+  // after two halvings leaves both far vertices above the plane.
+  EXPECT_EQ(y[11], 0.5);
+  for (unsigned int k = 0; k < 15; ++k)
+  {
+    if (k != 11)
+    {
+      EXPECT_EQ(y[k], x[k]) << k;
+    }
+  }
+  const double * pa[3] = { y.data(), y.data() + 3, y.data() + 6 };
+  const double * pb[3] = { y.data(), y.data() + 9, y.data() + 12 };
+  EXPECT_GT(itk::SurfaceCollisionDetail::SharedVertexGap(pa, 0, pb, 0), 0.0);
+
+  // A step that lifts b without folding it is left alone.
+  std::vector<double> lifted = x;
+  lifted[3 * 3 + 2] = 2.0;
+  const auto kept = collision.Constrain(x.data(), lifted.data(), 0.0, nullptr, 1);
+  EXPECT_EQ(kept.violations, 0u);
+  EXPECT_EQ(lifted[11], 2.0);
 }
 
 TEST(SurfaceCollision, DistanceAgreesWithTheIndependentCode)
