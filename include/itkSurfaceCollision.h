@@ -1806,14 +1806,15 @@ private:
     return m_SharedPairs[2 * q] == t ? m_SharedPairs[2 * q + 1] : m_SharedPairs[2 * q];
   }
 
-  /** SharedVertexGap() of the shared pair q at the positions x. */
-  double
-  SharedGap(SizeValueType q, const double * x) const
+  /** The vertex lists vt and vu of the two triangles of shared pair q, and
+   * the corners i of vt and j of vu where they hold their shared vertex. */
+  void
+  SharedCorners(SizeValueType q, const IndexType *& vt, const IndexType *& vu, unsigned int & i, unsigned int & j) const
   {
-    const IndexType * vt = m_Triangles.data() + 3 * m_SharedPairs[2 * q];
-    const IndexType * vu = m_Triangles.data() + 3 * m_SharedPairs[2 * q + 1];
-    unsigned int      i = 0;
-    unsigned int      j = 0;
+    vt = m_Triangles.data() + 3 * m_SharedPairs[2 * q];
+    vu = m_Triangles.data() + 3 * m_SharedPairs[2 * q + 1];
+    i = 0;
+    j = 0;
     for (unsigned int k = 0; k < 3; ++k)
     {
       for (unsigned int l = 0; l < 3; ++l)
@@ -1825,6 +1826,17 @@ private:
         }
       }
     }
+  }
+
+  /** SharedVertexGap() of the shared pair q at the positions x. */
+  double
+  SharedGap(SizeValueType q, const double * x) const
+  {
+    const IndexType * vt = nullptr;
+    const IndexType * vu = nullptr;
+    unsigned int      i = 0;
+    unsigned int      j = 0;
+    this->SharedCorners(q, vt, vu, i, j);
     const double * a[3] = { x + 3 * vt[0], x + 3 * vt[1], x + 3 * vt[2] };
     const double * b[3] = { x + 3 * vu[0], x + 3 * vu[1], x + 3 * vu[2] };
     return SurfaceCollisionDetail::SharedVertexGap(a, i, b, j);
@@ -1837,21 +1849,11 @@ private:
   double
   SharedGapLowerBound(SizeValueType q, const double * x) const
   {
-    const IndexType * vt = m_Triangles.data() + 3 * m_SharedPairs[2 * q];
-    const IndexType * vu = m_Triangles.data() + 3 * m_SharedPairs[2 * q + 1];
+    const IndexType * vt = nullptr;
+    const IndexType * vu = nullptr;
     unsigned int      i = 0;
     unsigned int      j = 0;
-    for (unsigned int k = 0; k < 3; ++k)
-    {
-      for (unsigned int l = 0; l < 3; ++l)
-      {
-        if (vt[k] == vu[l])
-        {
-          i = k;
-          j = l;
-        }
-      }
-    }
+    this->SharedCorners(q, vt, vu, i, j);
     using namespace SurfaceCollisionDetail;
     const double * v = x + 3 * vt[i];
     double         p[3], q1[3], r[3], s[3];
