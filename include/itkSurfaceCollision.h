@@ -1073,6 +1073,35 @@ public:
     bool          rebuilt{ false }; // the index was rebuilt
   };
 
+  /** For tuples of \a tupleSize keys (< numberOfKeys) stored one after the
+   * other in \a keys, the tuples that hold each key, in compressed rows:
+   * the tuples of key k are items[offsets[k]] to items[offsets[k + 1] - 1],
+   * in increasing order (a tuple holding k twice is listed twice). */
+  template <typename TOffset>
+  static void
+  GroupsOfKeys(const std::vector<IndexType> & keys,
+               unsigned int                   tupleSize,
+               SizeValueType                  numberOfKeys,
+               std::vector<TOffset> &         offsets,
+               std::vector<IndexType> &       items)
+  {
+    offsets.assign(numberOfKeys + 1, 0);
+    for (const IndexType k : keys)
+    {
+      ++offsets[k + 1];
+    }
+    for (SizeValueType k = 0; k < numberOfKeys; ++k)
+    {
+      offsets[k + 1] += offsets[k];
+    }
+    items.resize(keys.size());
+    std::vector<TOffset> next(offsets.begin(), offsets.end() - 1);
+    for (SizeValueType i = 0; i < keys.size(); ++i)
+    {
+      items[next[keys[i]]++] = static_cast<IndexType>(i / tupleSize);
+    }
+  }
+
   /** Sets the surface's connectivity: \a numberOfTriangles triangles of 3
    * point indices (< numberOfPoints) each. Drops the spatial index; the next
    * Constrain() builds it. Call again whenever the mesh changes (remeshing,
@@ -1082,24 +1111,8 @@ public:
   {
     m_NumberOfPoints = numberOfPoints;
     m_Triangles.assign(triangles, triangles + 3 * numberOfTriangles);
-    m_VertexTriangleOffsets.assign(numberOfPoints + 1, 0);
-    for (const IndexType v : m_Triangles)
-    {
-      ++m_VertexTriangleOffsets[v + 1];
-    }
-    for (SizeValueType i = 0; i < numberOfPoints; ++i)
-    {
-      m_VertexTriangleOffsets[i + 1] += m_VertexTriangleOffsets[i];
-    }
-    m_VertexTriangles.resize(m_Triangles.size());
-    std::vector<SizeValueType> fill(m_VertexTriangleOffsets.begin(), m_VertexTriangleOffsets.end() - 1);
-    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
-    {
-      for (unsigned int k = 0; k < 3; ++k)
-      {
-        m_VertexTriangles[fill[m_Triangles[3 * t + k]]++] = static_cast<IndexType>(t);
-      }
-    }
+    // Per point, the triangles that use it.
+    GroupsOfKeys(m_Triangles, 3, numberOfPoints, m_VertexTriangleOffsets, m_VertexTriangles);
     // The pairs sharing exactly one vertex (in one fan, not across an
     // edge): each once, t < u, and per triangle the pairs it is in.
     m_SharedPairs.clear();
@@ -1120,24 +1133,7 @@ public:
       }
     }
     const SizeValueType numberOfSharedPairs = m_SharedPairs.size() / 2;
-    m_SharedOffsets.assign(numberOfTriangles + 1, 0);
-    for (const IndexType t : m_SharedPairs)
-    {
-      ++m_SharedOffsets[t + 1];
-    }
-    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
-    {
-      m_SharedOffsets[t + 1] += m_SharedOffsets[t];
-    }
-    m_SharedOfTriangle.resize(m_SharedPairs.size());
-    {
-      std::vector<IndexType> next(m_SharedOffsets.begin(), m_SharedOffsets.end() - 1);
-      for (SizeValueType q = 0; q < numberOfSharedPairs; ++q)
-      {
-        m_SharedOfTriangle[next[m_SharedPairs[2 * q]]++] = static_cast<IndexType>(q);
-        m_SharedOfTriangle[next[m_SharedPairs[2 * q + 1]]++] = static_cast<IndexType>(q);
-      }
-    }
+    GroupsOfKeys(m_SharedPairs, 2, numberOfTriangles, m_SharedOffsets, m_SharedOfTriangle);
     m_SharedGaps.assign(numberOfSharedPairs, 0.0f);
     m_SharedExact.assign(numberOfSharedPairs, 0);
     m_HasSurface = true;
