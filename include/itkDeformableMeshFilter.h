@@ -500,9 +500,23 @@ public:
   itkSetClampMacro(ConvergenceFraction, double, 0.0, 1.0);
   itkGetConstMacro(ConvergenceFraction, double);
 
+  /** When on, the convergence test (ConvergenceTolerance, ConvergenceWindow,
+   * ConvergenceFraction, NumberOfActiveVertices) measures each vertex's
+   * displacement along its unit normal (the normal at the start of the
+   * iteration) instead of its whole displacement: vertices that only slide
+   * along the surface, such as a contour's points that TangentialElasticity
+   * spaces evenly after the shape has settled, do not keep the filter
+   * running, since the shape they describe no longer changes. The geometry
+   * pass then stores the normals whatever the other terms.
+   * LastMaximumDisplacement remains the whole displacement. Default: off. */
+  itkSetMacro(ConvergenceAlongNormals, bool);
+  itkGetConstMacro(ConvergenceAlongNormals, bool);
+  itkBooleanMacro(ConvergenceAlongNormals);
+
   /** Vertices that moved by ConvergenceTolerance or more in the last
-   * iteration (counted when ConvergenceFraction > 0 or DampOscillations is
-   * on; 0 otherwise). */
+   * iteration (along their normals with ConvergenceAlongNormals; counted
+   * when ConvergenceFraction > 0, DampOscillations or ConvergenceAlongNormals
+   * is on; 0 otherwise). */
   itkGetConstMacro(NumberOfActiveVertices, SizeValueType);
 
   /** When on, no step makes the surface intersect itself: after each step
@@ -768,13 +782,15 @@ private:
   void
   ConstrainSelfIntersections(std::vector<double> & blockMaximum, bool diagnose);
 
-  /** After the step, when DampOscillations is on or ConvergenceFraction > 0:
-   * scales each vertex's proposed displacement (from start to
-   * m_NextCoordinates) by its step factor and updates the factors and the
-   * blocks' largest displacements (DampOscillations), and counts the vertices
-   * that move by ConvergenceTolerance or more. */
+  /** After the step, when DampOscillations, ConvergenceFraction > 0 or
+   * ConvergenceAlongNormals is on: scales each vertex's proposed displacement
+   * (from start to m_NextCoordinates) by its step factor and updates the
+   * factors and the blocks' largest displacements (DampOscillations), and
+   * counts the vertices that move by ConvergenceTolerance or more (along
+   * their normals with ConvergenceAlongNormals, whose largest such
+   * displacement goes to \a largestNormal). */
   void
-  FinishStep(const double * start, std::vector<double> & blockMaximum, bool diagnose);
+  FinishStep(const double * start, std::vector<double> & blockMaximum, bool diagnose, double & largestNormal);
 
   /** The checks of the image terms' parameters (VerifyPreconditions()). */
   void
@@ -837,6 +853,7 @@ private:
   double        m_ConvergenceTolerance{ 0.0 };
   unsigned int  m_ConvergenceWindow{ 3 };
   double        m_ConvergenceFraction{ 0.0 };
+  bool          m_ConvergenceAlongNormals{ false };
   SizeValueType m_NumberOfActiveVertices{ 0 };
   bool          m_FixedBoundary{ false };
   SizeValueType m_NumberOfClosedContours{ 0 };

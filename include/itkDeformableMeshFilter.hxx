@@ -1072,7 +1072,8 @@ template <typename TMesh, typename TForceImage>
 void
 DeformableMeshFilter<TMesh, TForceImage>::FinishStep(const double *        start,
                                                      std::vector<double> & blockMaximum,
-                                                     bool                  diagnose)
+                                                     bool                  diagnose,
+                                                     double &              largestNormal)
 {
   using namespace DeformableMeshFilterDetail;
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
@@ -1083,9 +1084,21 @@ DeformableMeshFilter<TMesh, TForceImage>::FinishStep(const double *        start
   const SizeValueType        numberOfBlocks = blockMaximum.size();
   std::vector<SizeValueType> blockDamped(numberOfBlocks, 0);
   std::vector<SizeValueType> blockActive(numberOfBlocks, 0);
+  std::vector<double>        blockNormal(numberOfBlocks, 0.0);
   const bool                 damp = m_DampOscillations;
   const double               squaredTolerance = m_ConvergenceTolerance * m_ConvergenceTolerance;
   double *                   next = m_NextCoordinates.data();
+  // Along the normals: the squared component of d along the vertex's unit
+  // normal (stored by the geometry pass at the start of the iteration).
+  const float * normals = m_ConvergenceAlongNormals ? m_Normals.data() : nullptr;
+  const auto    measured = [normals](SizeValueType i, const double * d, double squared) {
+    if (normals == nullptr)
+    {
+      return squared;
+    }
+    const double along = d[0] * normals[4 * i] + d[1] * normals[4 * i + 1] + d[2] * normals[4 * i + 2];
+    return along * along;
+  };
   MultiThreaderBase *        threader = this->GetMultiThreader();
   threader->ParallelizeArray(
     0,
@@ -1094,6 +1107,7 @@ DeformableMeshFilter<TMesh, TForceImage>::FinishStep(const double *        start
       const SizeValueType begin = block * BlockSize;
       const SizeValueType end = std::min(numberOfPoints, begin + BlockSize);
       double              largest = 0.0;
+      double              largestAlong = 0.0;
       SizeValueType       damped = 0;
       SizeValueType       active = 0;
       for (SizeValueType i = begin; i < end; ++i)
@@ -1103,7 +1117,9 @@ DeformableMeshFilter<TMesh, TForceImage>::FinishStep(const double *        start
           const double d[3] = { next[3 * i] - start[3 * i],
                                 next[3 * i + 1] - start[3 * i + 1],
                                 next[3 * i + 2] - start[3 * i + 2] };
-          active += d[0] * d[0] + d[1] * d[1] + d[2] * d[2] >= squaredTolerance;
+          const double m = measured(i, d, d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+          largestAlong = std::max(largestAlong, m);
+          active += m >= squaredTolerance;
           continue;
         }
         std::array<float, 4> & state = m_OscillationState[i];
@@ -1142,7 +1158,9 @@ DeformableMeshFilter<TMesh, TForceImage>::FinishStep(const double *        start
         }
         const double squared = factor * factor * dd;
         largest = std::max(largest, squared);
-        active += squared >= squaredTolerance;
+        const double m = measured(i, d, squared);
+        largestAlong = std::max(largestAlong, m);
+        active += m >= squaredTolerance;
         if (diagnose)
         {
           m_DisplacementMagnitudes[i] = static_cast<float>(std::sqrt(squared));
@@ -1154,13 +1172,17 @@ DeformableMeshFilter<TMesh, TForceImage>::FinishStep(const double *        start
       }
       blockDamped[block] = damped;
       blockActive[block] = active;
+      blockNormal[block] = largestAlong;
     },
     nullptr);
+  largestNormal = 0.0;
   for (SizeValueType block = 0; block < numberOfBlocks; ++block)
   {
     m_NumberOfDampedVertices += blockDamped[block];
     m_NumberOfActiveVertices += blockActive[block];
+    largestNormal = std::max(largestNormal, blockNormal[block]);
   }
+  largestNormal = std::sqrt(largestNormal);
 }
 
 template <typename TMesh, typename TForceImage>
@@ -1177,8 +1199,9 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   // reference edge length the geometry pass also gives the edge weights.
   const bool useImageTerms = this->UsesImageTerms();
   const bool scaled = m_ReferenceEdgeLength > 0.0 && (useElasticity || m_Rigidity > 0.0);
-  const bool useRigidity = m_Rigidity > 0.0 || useImageTerms || scaled;
-  const bool useNormal = m_Balloon != 0.0 || (useElasticity && m_TangentialElasticity) || useImageTerms;
+  const bool useRigidity = m_Rigidity > 0.0 || useImageTerms || scaled || m_ConvergenceAlongNormals;
+  const bool useNormal =
+    m_Balloon != 0.0 || (useElasticity && m_TangentialElasticity) || useImageTerms || m_ConvergenceAlongNormals;
   if (m_FirstContourEnd >= 0 && (m_Balloon != 0.0 || m_RegionWeight > 0.0))
   {
     // Outward is the side away from the region a closed contour encloses;
@@ -1401,9 +1424,11 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
 
   m_NumberOfDampedVertices = 0;
   m_NumberOfActiveVertices = 0;
-  if (m_DampOscillations || m_ConvergenceFraction > 0.0)
+  double largestNormal = 0.0;
+  if (m_DampOscillations || m_ConvergenceFraction > 0.0 || m_ConvergenceAlongNormals)
   {
-    this->FinishStep(m_NumberOfSubSteps > 1 ? m_IterationStart.data() : coordinates.data(), blockMaximum, diagnose);
+    this->FinishStep(
+      m_NumberOfSubSteps > 1 ? m_IterationStart.data() : coordinates.data(), blockMaximum, diagnose, largestNormal);
   }
   if (m_PreventSelfIntersections)
   {
@@ -1414,10 +1439,11 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   m_LastMaximumDisplacement = *std::max_element(blockMaximum.begin(), blockMaximum.end());
   // Quiet: the largest displacement below the tolerance, or with
   // ConvergenceFraction > 0, at most that fraction of the vertices moving by
-  // the tolerance or more.
-  const bool quiet = m_ConvergenceFraction > 0.0 ? static_cast<double>(m_NumberOfActiveVertices) <=
+  // the tolerance or more (along their normals with ConvergenceAlongNormals).
+  const double largestMeasured = m_ConvergenceAlongNormals ? largestNormal : m_LastMaximumDisplacement;
+  const bool   quiet = m_ConvergenceFraction > 0.0 ? static_cast<double>(m_NumberOfActiveVertices) <=
                                                      m_ConvergenceFraction * static_cast<double>(numberOfPoints)
-                                                 : m_LastMaximumDisplacement < m_ConvergenceTolerance;
+                                                   : largestMeasured < m_ConvergenceTolerance;
   if (m_ConvergenceTolerance > 0.0 && quiet)
   {
     m_Converged = ++m_QuietIterations >= m_ConvergenceWindow;
@@ -1617,6 +1643,7 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "ConvergenceTolerance: " << m_ConvergenceTolerance << std::endl;
   os << indent << "ConvergenceWindow: " << m_ConvergenceWindow << std::endl;
   os << indent << "ConvergenceFraction: " << m_ConvergenceFraction << std::endl;
+  os << indent << "ConvergenceAlongNormals: " << (m_ConvergenceAlongNormals ? "On" : "Off") << std::endl;
   os << indent << "NumberOfActiveVertices: " << m_NumberOfActiveVertices << std::endl;
   os << indent << "DampOscillations: " << (m_DampOscillations ? "On" : "Off") << std::endl;
   os << indent << "NumberOfDampedVertices: " << m_NumberOfDampedVertices << std::endl;

@@ -25,6 +25,9 @@
 
 #include "itkSampledGaussianSmoothing.h"
 
+#include <cstdint>
+#include <cstring>
+
 namespace itk
 {
 
@@ -102,14 +105,21 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareImageTerms()
     // statistics neither overflow nor lose their precision in float.
     const float * buffer = image->GetBufferPointer();
     const size_t  count = image->GetBufferedRegion().GetNumberOfPixels();
-    // The largest magnitude, in a loop without branches (vectorised): a
-    // non-finite value makes it infinite or NaN, and is then looked for.
-    float largest = 0.0f;
+    // The largest magnitude, as the largest of the values' bits without the
+    // sign: for IEEE floats that order is the order of the magnitudes, with
+    // the infinities and NaNs above every finite value. An integer maximum
+    // without branches, which the compiler vectorises (a float comparison
+    // that must see NaNs is not); a non-finite value is then looked for.
+    uint32_t largestBits = 0;
     for (size_t i = 0; i < count; ++i)
     {
-      const float magnitude = std::abs(buffer[i]);
-      largest = magnitude > largest || magnitude != magnitude ? magnitude : largest;
+      uint32_t bits;
+      std::memcpy(&bits, buffer + i, sizeof(bits));
+      bits &= 0x7fffffffu;
+      largestBits = bits > largestBits ? bits : largestBits;
     }
+    float largest;
+    std::memcpy(&largest, &largestBits, sizeof(largest));
     if (!std::isfinite(largest))
     {
       for (size_t i = 0; i < count; ++i)

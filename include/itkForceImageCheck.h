@@ -109,7 +109,27 @@ private:
 
     const auto *        pixels = image->GetBufferPointer();
     const SizeValueType n = region.GetNumberOfPixels();
-    double              largestSquared = 0.0;
+    // The largest squared length, in a loop without branches (vectorised): a
+    // non-finite component makes it infinite or NaN, and only then is the
+    // first such pixel looked for.
+    double largestSquared = 0.0;
+    for (SizeValueType i = 0; i < n; ++i)
+    {
+      double squared = 0.0;
+      for (unsigned int k = 0; k < ForceImageType::PixelType::Dimension; ++k)
+      {
+        const double v = static_cast<double>(pixels[i][k]);
+        squared += v * v;
+      }
+      largestSquared = squared > largestSquared || squared != squared ? squared : largestSquared;
+    }
+    if (std::isfinite(largestSquared))
+    {
+      m_LargestForce = std::sqrt(largestSquared);
+      m_Diagonal = PhysicalDiagonal(image);
+      return;
+    }
+    largestSquared = 0.0;
     for (SizeValueType i = 0; i < n && !m_NonFinite; ++i)
     {
       double squared = 0.0;
@@ -127,8 +147,13 @@ private:
       largestSquared = std::max(largestSquared, squared);
     }
     m_LargestForce = std::sqrt(largestSquared);
+    m_Diagonal = PhysicalDiagonal(image);
+  }
 
-    // The physical diagonal of the image's voxels.
+  /** The physical diagonal of the image's voxels. */
+  static double
+  PhysicalDiagonal(const ForceImageType * image)
+  {
     double squaredDiagonal = 0.0;
     for (unsigned int d = 0; d < ImageDimension; ++d)
     {
@@ -136,7 +161,7 @@ private:
         static_cast<double>(image->GetLargestPossibleRegion().GetSize()[d]) * image->GetSpacing()[d];
       squaredDiagonal += extent * extent;
     }
-    m_Diagonal = std::sqrt(squaredDiagonal);
+    return std::sqrt(squaredDiagonal);
   }
 
   const ForceImageType *              m_Image{ nullptr };

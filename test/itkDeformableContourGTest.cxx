@@ -759,6 +759,71 @@ TEST(DeformableContour, StepBoundAndConvergence)
   EXPECT_LE(maximum, 0.3);
 }
 
+// Convergence along the normals: 120 points on the edge of a disc of radius
+// 14 pixels, spaced unevenly (0.4 to 1.6 times their mean spacing), the
+// tangential elasticity on. The shape is settled from the start; only the
+// points slide along it toward even spacing. Measured on the whole
+// displacement the filter runs while they slide; along the normals it stops
+// within a few tens of iterations although they are still sliding by more
+// than the tolerance, and both contours lie on the circle.
+TEST(DeformableContour, ConvergenceAlongNormalsIgnoresPointsSlidingAlongTheContour)
+{
+  const PointType center = Point(24.3, 23.8);
+  const auto      image = MakeImage(UnitGeometry(48), center, InsideEllipse(center, 14.0, 14.0, 0.0));
+  const auto      forces = Forces(image, 1.0, false);
+  constexpr unsigned int n = 120;
+  auto                   uneven = MeshType::New();
+  for (unsigned int k = 0; k < n; ++k)
+  {
+    const double u = 2.0 * pi * k / n;
+    const double t = u + 0.6 * std::sin(u);
+    uneven->SetPoint(k, Point(center[0] + 14.0 * std::cos(t), center[1] + 14.0 * std::sin(t)));
+  }
+  CellType::CellAutoPointer cell;
+  cell.TakeOwnership(new PolygonType);
+  for (unsigned int k = 0; k < n; ++k)
+  {
+    cell->SetPointId(k, k);
+  }
+  uneven->SetCell(0, cell);
+
+  constexpr double tolerance = 0.002;
+  itk::SizeValueType iterations[2] = { 0, 0 };
+  for (const bool alongNormals : { false, true })
+  {
+    auto filter = FilterType::New();
+    filter->SetInput(uneven);
+    filter->SetForceImage(forces);
+    filter->SetScaleFactor(0.5);
+    filter->SetElasticity(0.3);
+    filter->SetTangentialElasticity(true);
+    filter->SetRigidity(0.05);
+    filter->SetConvergenceTolerance(tolerance);
+    filter->SetConvergenceWindow(3);
+    filter->SetConvergenceAlongNormals(alongNormals);
+    filter->SetNumberOfIterations(3000);
+    filter->Update();
+    iterations[alongNormals] = filter->GetCurrentIteration();
+    double mean = 0.0;
+    double maximum = 0.0;
+    MeasureDistance(filter->GetOutput(), Ellipse(center, 14.0, 14.0, 0.0), mean, maximum);
+    std::cout << (alongNormals ? "along the normals: " : "whole displacement: ") << iterations[alongNormals]
+              << " iterations, converged " << filter->GetConverged() << ", last largest displacement "
+              << filter->GetLastMaximumDisplacement() << ", mean distance " << mean << " pixel, max " << maximum
+              << std::endl;
+    EXPECT_TRUE(filter->GetConverged());
+    EXPECT_LE(mean, 0.1);
+    EXPECT_LE(maximum, 0.3);
+    if (alongNormals)
+    {
+      // Stopped while the points still slide.
+      EXPECT_GT(filter->GetLastMaximumDisplacement(), tolerance);
+      EXPECT_LE(filter->GetCurrentIteration(), 50u);
+    }
+  }
+  EXPECT_GT(iterations[0], 4 * iterations[1]);
+}
+
 // A contour whose points are numbered far apart (a circle of 8192 points
 // given in a shuffled order, its line cells following the circle) is
 // renumbered internally for locality: the output, in the input's numbering,

@@ -192,6 +192,9 @@ struct LevelSchedule
   double       edgeSearchDistance{ 0.0 }; // mm
   double       edgeLength{ 0.0 };         // mm, the mean edge the refinement aims at
   bool         tangentialElasticity{ false };
+  bool         convergenceAlongNormals{ false }; // the convergence test on the displacements' normal parts
+  double       captureRegionWeightFactor{ 1.0 }; // the capture level's region weight over the others'
+  double       captureRegionSigmaFactor{ defaults::CoarseRegionSigmaFactor }; // the same for the region sigma
   const char * pointsWord{ "vertices" }; // what the progress calls the mesh's points
   const char * initialWhat{ "surface" }; // "surface" or "contour", for the notes
 };
@@ -243,9 +246,12 @@ ConfigureLevel(TFilter *              deform,
   // coarser level (the surface does not creep into sulci and fissures as its
   // mesh is refined), and the finest level converges within its iterations.
   const double levelEdge = meanEdgeLength / (defaults::FineLevelEdgeLengths * s.edgeLength);
-  deform->SetRegionWeight(stage == 0 ? s.regionWeight : s.regionWeight * std::min(1.0, levelEdge * levelEdge));
-  // The capture level's region force sees the image smoothed more.
-  deform->SetRegionSigma(capture ? defaults::CoarseRegionSigmaFactor * s.regionSigma : s.regionSigma);
+  // The capture level's region force may be faster and see the image
+  // smoothed more (LevelSchedule's capture factors).
+  deform->SetRegionWeight(capture      ? s.captureRegionWeightFactor * s.regionWeight
+                          : stage == 0 ? s.regionWeight
+                                       : s.regionWeight * std::min(1.0, levelEdge * levelEdge));
+  deform->SetRegionSigma(capture ? s.captureRegionSigmaFactor * s.regionSigma : s.regionSigma);
   deform->SetIntensityTolerance(o.intensityTolerance);
   deform->SetEdgeSearchWeight(s.edgeSearchWeight);
   deform->SetEdgeSearchDistance(s.edgeSearchDistance);
@@ -267,6 +273,7 @@ ConfigureLevel(TFilter *              deform,
   deform->SetConvergenceTolerance(o.convergenceTolerance);
   deform->SetConvergenceWindow(o.convergenceWindow);
   deform->SetConvergenceFraction(o.convergenceFraction);
+  deform->SetConvergenceAlongNormals(s.convergenceAlongNormals);
   // The capture level runs until it converges, up to CaptureIterations (or
   // --iterations when larger): from a small sphere it travels far, and its
   // front slows down as it fills narrow lobes (ch2: 700 iterations), so that
@@ -360,8 +367,8 @@ RunLevel(TFilter *                                       deform,
     o.convergenceFraction > 0.0
       ? "at most " +
           std::to_string(static_cast<unsigned long long>(o.convergenceFraction * static_cast<double>(numberOfPoints))) +
-          " " + s.pointsWord + " moving by "
-      : std::string("largest step below ");
+          " " + s.pointsWord + " moving" + (s.convergenceAlongNormals ? " along their normals" : "") + " by "
+      : std::string(s.convergenceAlongNormals ? "largest step along the normals below " : "largest step below ");
   progress.Finish(std::to_string(deform->GetCurrentIteration()) + " iterations on " + level + ", " +
                   (state.converged ? "converged (" + quiet + Format(deform->GetConvergenceTolerance()) + " mm for " +
                                        std::to_string(o.convergenceWindow) + " iterations)"
