@@ -502,14 +502,20 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopologyFromRemesher()
   using namespace DeformableMeshFilterDetail;
   // Each vertex's fan from the remesher's corner table: a closed ring from
   // its smallest neighbour, an open one from its boundary end, as
-  // BuildTopology() orders them.
+  // BuildTopology() orders them. The rings' sizes are the remesher's
+  // valences, so that each ring is walked once, straight into its place.
   const SizeValueType      numberOfPoints = this->GetNumberOfCachedPoints();
   constexpr SizeValueType  block = 16384;
   const SizeValueType      numberOfBlocks = (numberOfPoints + block - 1) / block;
   std::vector<IndexType32> offsets(numberOfPoints + 1, 0);
-  std::vector<uint8_t>     kinds(numberOfPoints, GeneralVertex);
-  std::vector<uint8_t>     blockFans(numberOfBlocks, 1);
-  MultiThreaderBase *      threader = this->GetMultiThreader();
+  for (SizeValueType i = 0; i < numberOfPoints; ++i)
+  {
+    offsets[i + 1] = offsets[i] + static_cast<IndexType32>(m_Remesher.OutputValence(static_cast<IndexType32>(i)));
+  }
+  std::vector<uint8_t> kinds(numberOfPoints, GeneralVertex);
+  std::vector<uint8_t> blockFans(numberOfBlocks, 1);
+  m_Neighbours.resize(offsets[numberOfPoints]);
+  MultiThreaderBase * threader = this->GetMultiThreader();
   threader->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
   threader->ParallelizeArray(
     0,
@@ -519,34 +525,13 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopologyFromRemesher()
       for (SizeValueType i = b * block; i < std::min(numberOfPoints, (b + 1) * block); ++i)
       {
         const int kind = m_Remesher.OutputRing(static_cast<IndexType32>(i), ring);
-        if (kind == 0 || ring.size() < 2)
+        if (kind == 0 || ring.size() < 2 || ring.size() != offsets[i + 1] - offsets[i])
         {
           blockFans[b] = 0;
           return;
         }
-        offsets[i + 1] = static_cast<IndexType32>(ring.size());
         kinds[i] = kind == 1 ? ClosedRing : OpenRing;
-      }
-    },
-    nullptr);
-  if (std::find(blockFans.begin(), blockFans.end(), 0) != blockFans.end())
-  {
-    return false;
-  }
-  for (SizeValueType i = 0; i < numberOfPoints; ++i)
-  {
-    offsets[i + 1] += offsets[i];
-  }
-  m_Neighbours.resize(offsets[numberOfPoints]);
-  threader->ParallelizeArray(
-    0,
-    numberOfBlocks,
-    [&](SizeValueType b) {
-      std::vector<IndexType32> ring;
-      for (SizeValueType i = b * block; i < std::min(numberOfPoints, (b + 1) * block); ++i)
-      {
-        m_Remesher.OutputRing(static_cast<IndexType32>(i), ring);
-        if (kinds[i] == ClosedRing)
+        if (kind == 1)
         {
           std::rotate(ring.begin(), std::min_element(ring.begin(), ring.end()), ring.end());
         }
@@ -554,6 +539,10 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopologyFromRemesher()
       }
     },
     nullptr);
+  if (std::find(blockFans.begin(), blockFans.end(), 0) != blockFans.end())
+  {
+    return false;
+  }
   m_NeighbourOffsets.swap(offsets);
   m_RingKinds.swap(kinds);
   m_GeneralVertices.clear();

@@ -28,6 +28,9 @@
 #include <limits>
 #include <numeric>
 #include <vector>
+#if defined(_MSC_VER)
+#  include <intrin.h>
+#endif
 
 namespace itk
 {
@@ -188,6 +191,15 @@ public:
   int
   OutputRing(IndexType v, std::vector<IndexType> & neighbours) const;
 
+  /** The number of neighbours of vertex \a v of the last Remesh()'s output
+   * as the remesher counts them: the size of OutputRing()'s ring when \a v
+   * is not frozen. */
+  std::size_t
+  OutputValence(IndexType v) const
+  {
+    return m_TableValid && v < m_Valence.size() ? static_cast<std::size_t>(m_Valence[v]) : 0;
+  }
+
   /** For each vertex of the last Remesh()'s output, the input vertex it
    * comes from. */
   const std::vector<IndexType> &
@@ -219,9 +231,25 @@ public:
 
 private:
   static constexpr IndexType Invalid = std::numeric_limits<IndexType>::max();
-  static constexpr int64_t   Boundary = -1;
-  static constexpr int64_t   NonManifold = -2;
+  // A corner's link to the opposite half-edge: its corner, Boundary or
+  // NonManifold. 32 bits (the corner table is the remesher's largest array):
+  // Remesh() refuses meshes of more than about 2^31 corners.
+  using Link = int32_t;
+  static constexpr Link Boundary = -1;
+  static constexpr Link NonManifold = -2;
 
+  /** The position of the lowest set bit of \a bits (not 0). */
+  static unsigned int
+  LowestBit(uint64_t bits)
+  {
+#if defined(_MSC_VER)
+    unsigned long position = 0;
+    _BitScanForward64(&position, bits);
+    return static_cast<unsigned int>(position);
+#else
+    return static_cast<unsigned int>(__builtin_ctzll(bits));
+#endif
+  }
   static IndexType
   Next(IndexType c)
   {
@@ -265,6 +293,10 @@ private:
    * \a lengthen, when the new edge is longer and at most the maximum. */
   bool
   TryFlip(IndexType c, bool lengthen = false);
+  /** The cheap part of TryFlip(c): an interior edge listed from c whose
+   * flip would bring the valences closer to 6 (4 on a boundary). */
+  bool
+  FlipImprovesValences(IndexType c) const;
   void
   Relax();
   /** Moves the end-points of each edge still shorter than the minimum apart
@@ -272,12 +304,56 @@ private:
    * turns around. */
   void
   LengthenPass();
+  /** Whether moving free vertex \a v, of neighbours \a ring and corners
+   * \a corners (Ring()), to \a q keeps its edges other than the one to
+   * \a other within the band and turns none of its triangles around. */
   bool
-  MoveKeepsBand(IndexType v, const double * q, IndexType other);
-  /** Runs body(begin, end) over [0, n) in blocks, on the threader if any. */
+  MoveKeepsBand(IndexType                      v,
+                const double *                 q,
+                IndexType                      other,
+                const std::vector<IndexType> & ring,
+                const std::vector<IndexType> & corners) const;
+  /** Runs body(begin, end) over [0, n) in blocks of \a blockSize, on the
+   * threader if any. */
   template <typename TBody>
   void
-  ParallelFor(std::size_t n, TBody && body) const;
+  ParallelFor(std::size_t n, TBody && body, std::size_t blockSize = 8192) const;
+
+  /** What an operation of the running Sweep() changes in the tests of the
+   * corners still to come: the lengths and twins of edges (collapse and
+   * lengthening passes), or also the valences (flip pass). */
+  enum class SweepInputs : uint8_t
+  {
+    None,
+    Lengths,
+    Valences
+  };
+  /** Calls body(c) for each corner c, in increasing order, for which
+   * candidate(c) holds, as a serial loop over every corner calling body(c)
+   * would: candidate(c) is a necessary condition of body(c) doing anything,
+   * tested in parallel on the mesh as it is before the sweep; the
+   * operations body() makes queue again the corners whose test they may
+   * have changed (Requeue()), so that the result is the same, bit for bit,
+   * as that of the serial loop. */
+  template <typename TCandidate, typename TBody>
+  void
+  Sweep(SweepInputs inputs, TCandidate && candidate, TBody && body);
+  /** Queues corner \a k and its twin for the running sweep, when ahead of it. */
+  void
+  Requeue(int64_t k)
+  {
+    for (const int64_t corner : { k, k >= 0 ? m_O[static_cast<std::size_t>(k)] : k })
+    {
+      if (corner > static_cast<int64_t>(m_SweepPosition))
+      {
+        m_Queue[static_cast<std::size_t>(corner) >> 6] |= uint64_t{ 1 } << (corner & 63);
+      }
+    }
+  }
+  /** Queues the three corners (and their twins) of each triangle of the
+   * fan of \a v. */
+  void
+  RequeueFan(IndexType v);
   void
   Compact(std::vector<double> & coordinates, std::vector<IndexType> & triangles);
 
@@ -292,7 +368,7 @@ private:
   // half-edge of corner c goes from m_V[c] to m_V[Next(c)]; m_O[c] is the
   // corner of the opposite half-edge, Boundary or NonManifold.
   std::vector<IndexType> m_V;
-  std::vector<int64_t>   m_O;
+  std::vector<Link>      m_O;
   std::vector<IndexType> m_VertexCorner; // a corner of each vertex, Invalid if none
   std::vector<int32_t>   m_Valence;
   std::vector<uint8_t>   m_State; // 0 free, 1 boundary, 2 frozen, 3 removed
@@ -306,11 +382,24 @@ private:
   Statistics             m_Statistics;
   double                 m_Min2{ 0.0 };
   double                 m_Max2{ 0.0 };
-  // Scratch.
-  std::vector<IndexType> m_RingA;
-  std::vector<IndexType> m_RingB;
-  std::vector<IndexType> m_CornersA;
-  std::vector<IndexType> m_CornersB;
+  // The running Sweep(): its inputs, position and queue (a bit per corner).
+  SweepInputs           m_SweepInputs{ SweepInputs::None };
+  IndexType             m_SweepPosition{ 0 };
+  std::vector<uint64_t> m_Queue;
+  // Scratch, kept between calls so that large arrays are not allocated (and
+  // their pages faulted in) at every remeshing.
+  std::vector<std::pair<double, IndexType>> m_SplitCandidates;
+  std::vector<double>                       m_Moved;
+  std::vector<IndexType>                    m_Root;
+  std::vector<IndexType>                    m_Start;
+  std::vector<IndexType>                    m_ScratchParents;
+  std::vector<uint8_t>                      m_ScratchState;
+  std::vector<int32_t>                      m_ScratchValence;
+  std::vector<Link>                         m_ScratchO;
+  std::vector<IndexType>                    m_RingA;
+  std::vector<IndexType>                    m_RingB;
+  std::vector<IndexType>                    m_CornersA;
+  std::vector<IndexType>                    m_CornersB;
 };
 
 enum : uint8_t
@@ -375,10 +464,9 @@ DeformableMeshRemesher::NewVertex(const double * p, IndexType parent)
 
 template <typename TBody>
 void
-DeformableMeshRemesher::ParallelFor(std::size_t n, TBody && body) const
+DeformableMeshRemesher::ParallelFor(std::size_t n, TBody && body, std::size_t blockSize) const
 {
-  constexpr std::size_t blockSize = 8192;
-  const std::size_t     blocks = (n + blockSize - 1) / blockSize;
+  const std::size_t blocks = (n + blockSize - 1) / blockSize;
   if (m_Threader == nullptr || blocks < 2)
   {
     body(std::size_t{ 0 }, n);
@@ -395,6 +483,59 @@ DeformableMeshRemesher::ParallelFor(std::size_t n, TBody && body) const
     nullptr);
 }
 
+template <typename TCandidate, typename TBody>
+void
+DeformableMeshRemesher::Sweep(SweepInputs inputs, TCandidate && candidate, TBody && body)
+{
+  const std::size_t numberOfCorners = m_V.size();
+  const std::size_t words = (numberOfCorners + 63) / 64;
+  m_Queue.resize(words);
+  this->ParallelFor(
+    words,
+    [&](std::size_t first, std::size_t last) {
+      for (std::size_t w = first; w < last; ++w)
+      {
+        uint64_t          bits = 0;
+        const std::size_t end = std::min<std::size_t>(64, numberOfCorners - 64 * w);
+        for (std::size_t j = 0; j < end; ++j)
+        {
+          bits |= static_cast<uint64_t>(candidate(static_cast<IndexType>(64 * w + j))) << j;
+        }
+        m_Queue[w] = bits;
+      }
+    },
+    1024);
+  m_SweepInputs = inputs;
+  for (std::size_t w = 0; w < words; ++w)
+  {
+    // Read again after each corner: its operation may queue later corners
+    // of the same word.
+    for (uint64_t bits = m_Queue[w]; bits != 0; bits = m_Queue[w])
+    {
+      const unsigned int j = LowestBit(bits);
+      m_Queue[w] = bits & (bits - 1);
+      m_SweepPosition = static_cast<IndexType>(64 * w + j);
+      body(m_SweepPosition);
+    }
+  }
+  m_SweepInputs = SweepInputs::None;
+}
+
+inline void
+DeformableMeshRemesher::RequeueFan(IndexType v)
+{
+  if (!this->Ring(v, m_RingA, &m_CornersA))
+  {
+    return;
+  }
+  for (const IndexType k : m_CornersA)
+  {
+    this->Requeue(k);
+    this->Requeue(Next(k));
+    this->Requeue(Prev(k));
+  }
+}
+
 inline void
 DeformableMeshRemesher::Build(std::size_t numberOfPoints)
 {
@@ -409,12 +550,22 @@ DeformableMeshRemesher::Build(std::size_t numberOfPoints)
   {
     offsets[i + 1] += offsets[i];
   }
+  // With each corner, the vertices after and before it in its triangle: the
+  // search of the twins below then reads them in sequence.
   std::vector<IndexType> corners(numberOfCorners);
+  std::vector<IndexType> nextVertex(numberOfCorners);
+  std::vector<IndexType> previousVertex(numberOfCorners);
   {
     std::vector<IndexType> fill(offsets.begin(), offsets.end() - 1);
-    for (std::size_t c = 0; c < numberOfCorners; ++c)
+    for (std::size_t t = 0; t < numberOfCorners; t += 3)
     {
-      corners[fill[m_V[c]]++] = static_cast<IndexType>(c);
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        const IndexType slot = fill[m_V[t + k]]++;
+        corners[slot] = static_cast<IndexType>(t + k);
+        nextVertex[slot] = m_V[t + (k + 1) % 3];
+        previousVertex[slot] = m_V[t + (k + 2) % 3];
+      }
     }
   }
   m_O.assign(numberOfCorners, Boundary);
@@ -433,12 +584,11 @@ DeformableMeshRemesher::Build(std::size_t numberOfPoints)
       }
       for (IndexType k = offsets[a]; k < offsets[a + 1]; ++k)
       {
-        const IndexType d = corners[k];
-        same += m_V[Next(d)] == b;
-        opposite += m_V[Prev(d)] == b; // half-edge b -> a ends at a
-        if (m_V[Prev(d)] == b)
+        same += nextVertex[k] == b;
+        opposite += previousVertex[k] == b; // half-edge b -> a ends at a
+        if (previousVertex[k] == b)
         {
-          twin = Prev(d);
+          twin = Prev(corners[k]);
         }
       }
       if (same == 1 && opposite == 1)
@@ -528,7 +678,7 @@ DeformableMeshRemesher::Ring(IndexType v, std::vector<IndexType> & neighbours, s
   std::size_t guard = 0;
   while (m_State[v] != RemesherFree)
   {
-    const int64_t o = m_O[c];
+    const Link o = m_O[c];
     if (o == NonManifold)
     {
       return false;
@@ -557,7 +707,7 @@ DeformableMeshRemesher::Ring(IndexType v, std::vector<IndexType> & neighbours, s
     }
     neighbours.push_back(m_V[Next(c)]);
     const IndexType p = Prev(c);
-    const int64_t   o = m_O[p];
+    const Link      o = m_O[p];
     if (o == NonManifold)
     {
       return false;
@@ -588,7 +738,7 @@ DeformableMeshRemesher::Split(IndexType c)
   const IndexType pc = Prev(c);
   const IndexType b = m_V[nc];
   const IndexType C = m_V[pc];
-  const int64_t   o = m_O[c];
+  const Link      o = m_O[c];
   const double *  pa = m_X.data() + 3 * static_cast<std::size_t>(a);
   const double *  pb = m_X.data() + 3 * static_cast<std::size_t>(b);
   const double    mid[3] = { 0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1]), 0.5 * (pa[2] + pb[2]) };
@@ -599,8 +749,8 @@ DeformableMeshRemesher::Split(IndexType c)
   }
 
   // Triangle t = (a, b, C) becomes (a, m, C); new t2 = (m, b, C).
-  const auto    t2 = static_cast<IndexType>(m_V.size());
-  const int64_t oldNext = m_O[nc]; // twin of b -> C
+  const auto t2 = static_cast<IndexType>(m_V.size());
+  const Link oldNext = m_O[nc]; // twin of b -> C
   m_V[nc] = m;
   m_V.push_back(m);
   m_V.push_back(b);
@@ -630,7 +780,7 @@ DeformableMeshRemesher::Split(IndexType c)
     const IndexType po = Prev(oc);
     const IndexType D = m_V[po];
     const auto      u2 = static_cast<IndexType>(m_V.size());
-    const int64_t   oldNextU = m_O[no]; // twin of a -> D
+    const Link      oldNextU = m_O[no]; // twin of a -> D
     m_V[no] = m;
     m_V.push_back(m);
     m_V.push_back(a);
@@ -674,13 +824,14 @@ DeformableMeshRemesher::SplitPass(bool all)
   // The long edges of the mesh as it is, longest first: splitting a long
   // edge before the shorter ones around it avoids fans of thin triangles.
   // Each edge is listed from its corner of lower index (or its only one).
-  std::vector<std::pair<double, IndexType>> candidates;
-  const auto                                consider = [&](IndexType c) {
+  std::vector<std::pair<double, IndexType>> & candidates = m_SplitCandidates;
+  candidates.clear();
+  const auto consider = [this](IndexType c, std::vector<std::pair<double, IndexType>> & found) {
     if (m_V[c] == Invalid)
     {
       return;
     }
-    const int64_t o = m_O[c];
+    const Link o = m_O[c];
     if (o == NonManifold)
     {
       return;
@@ -694,18 +845,33 @@ DeformableMeshRemesher::SplitPass(bool all)
     const double length2 = this->Length2(a, b);
     if (length2 > m_Max2)
     {
-      candidates.emplace_back(length2, o >= 0 && o < static_cast<int64_t>(c) ? static_cast<IndexType>(o) : c);
+      found.emplace_back(length2, o >= 0 && o < static_cast<int64_t>(c) ? static_cast<IndexType>(o) : c);
     }
   };
   if (all)
   {
-    for (IndexType c = 0; c < m_V.size(); ++c)
+    // In parallel: the candidates are sorted below, so their order here
+    // does not matter.
+    constexpr std::size_t                                  blockSize = 65536;
+    const std::size_t                                      numberOfCorners = m_V.size();
+    std::vector<std::vector<std::pair<double, IndexType>>> parts((numberOfCorners + blockSize - 1) / blockSize);
+    this->ParallelFor(
+      numberOfCorners,
+      [&](std::size_t first, std::size_t last) {
+        std::vector<std::pair<double, IndexType>> & part = parts[first / blockSize];
+        for (std::size_t c = first; c < last; ++c)
+        {
+          const Link o = m_O[c];
+          if (o < 0 || o > static_cast<int64_t>(c))
+          {
+            consider(static_cast<IndexType>(c), part);
+          }
+        }
+      },
+      blockSize);
+    for (const auto & part : parts)
     {
-      const int64_t o = m_O[c];
-      if (o < 0 || o > static_cast<int64_t>(c))
-      {
-        consider(c);
-      }
+      candidates.insert(candidates.end(), part.begin(), part.end());
     }
   }
   else
@@ -716,7 +882,7 @@ DeformableMeshRemesher::SplitPass(bool all)
     {
       for (IndexType c = 3 * t; c < 3 * t + 3; ++c)
       {
-        consider(c);
+        consider(c, candidates);
       }
     }
   }
@@ -731,6 +897,10 @@ DeformableMeshRemesher::SplitPass(bool all)
     const IndexType c = candidate.second;
     if (m_O[c] != NonManifold && this->Length2(m_V[c], m_V[Next(c)]) > m_Max2)
     {
+      if (m_V.size() + 6 > static_cast<std::size_t>(std::numeric_limits<Link>::max()))
+      {
+        itkGenericExceptionMacro("DeformableMeshRemesher: the splits make more than 2^31 triangle corners.");
+      }
       this->Split(c);
     }
   }
@@ -740,7 +910,7 @@ DeformableMeshRemesher::SplitPass(bool all)
 inline bool
 DeformableMeshRemesher::TryCollapse(IndexType c, bool fromTwin)
 {
-  const int64_t o = m_O[c];
+  const Link o = m_O[c];
   if (o < 0)
   {
     return false;
@@ -870,10 +1040,10 @@ DeformableMeshRemesher::TryCollapse(IndexType c, bool fromTwin)
   const auto      oc = static_cast<IndexType>(o);
   const IndexType no = Next(oc);
   const IndexType po = Prev(oc);
-  const int64_t   x = m_O[nc]; // C -> b
-  const int64_t   y = m_O[pc]; // a -> C
-  const int64_t   z = m_O[no]; // D -> a
-  const int64_t   w = m_O[po]; // b -> D
+  const Link      x = m_O[nc]; // C -> b
+  const Link      y = m_O[pc]; // a -> C
+  const Link      z = m_O[no]; // D -> a
+  const Link      w = m_O[po]; // b -> D
   // x and w are interior (b is free); y and z may be boundary half-edges
   // when a is a boundary vertex.
   m_O[x] = y;
@@ -901,31 +1071,71 @@ DeformableMeshRemesher::TryCollapse(IndexType c, bool fromTwin)
   m_State[b] = RemesherRemoved;
   std::copy(mid, mid + 3, m_X.data() + 3 * static_cast<std::size_t>(a));
   ++m_Statistics.collapses;
+  if (m_SweepInputs != SweepInputs::None)
+  {
+    // Every edge of a changed (its end-point, twin or length).
+    for (const std::vector<IndexType> * corners : { &m_CornersA, &m_CornersB })
+    {
+      for (const IndexType k : *corners)
+      {
+        if (k / 3 != tc && k / 3 != to)
+        {
+          this->Requeue(k);
+          this->Requeue(Prev(k));
+        }
+      }
+    }
+  }
   return true;
 }
 
 inline void
 DeformableMeshRemesher::CollapsePass()
 {
-  for (IndexType c = 0; c < m_V.size(); ++c)
-  {
-    if (m_V[c] == Invalid || m_O[c] < static_cast<int64_t>(c))
-    {
-      continue; // removed, boundary, frozen, or seen from its twin
-    }
+  // The short edges: those of the mesh before the pass, and those that the
+  // collapses and flips of the pass change (queued again).
+  const auto shortEdge = [this](IndexType c) {
+    // Not removed, boundary, frozen, or seen from its twin.
+    return m_V[c] != Invalid && m_O[c] >= static_cast<int64_t>(c) && this->Length2(m_V[c], m_V[Next(c)]) < m_Min2;
+  };
+  this->Sweep(SweepInputs::Lengths, shortEdge, [&](IndexType c) {
     // A short edge that cannot be collapsed is flipped to the longer
     // diagonal when that one is within the band.
-    if (this->Length2(m_V[c], m_V[Next(c)]) < m_Min2 && !this->TryCollapse(c))
+    if (shortEdge(c) && !this->TryCollapse(c))
     {
       this->TryFlip(c, true);
     }
+  });
+}
+
+inline bool
+DeformableMeshRemesher::FlipImprovesValences(IndexType c) const
+{
+  const Link o = m_O[c];
+  if (o < static_cast<int64_t>(c))
+  {
+    return false; // boundary, frozen, or seen from its twin
   }
+  const IndexType a = m_V[c];
+  const IndexType b = m_V[Next(c)];
+  const IndexType C = m_V[Prev(c)];
+  const IndexType D = m_V[Prev(static_cast<IndexType>(o))];
+  if (C == D || m_State[a] >= RemesherFrozen || m_State[b] >= RemesherFrozen || m_State[C] >= RemesherFrozen ||
+      m_State[D] >= RemesherFrozen)
+  {
+    return false;
+  }
+  const auto deviation = [this](IndexType v, int change) {
+    return std::abs(m_Valence[v] + change - (m_State[v] == RemesherBoundary ? 4 : 6));
+  };
+  return deviation(a, -1) + deviation(b, -1) + deviation(C, 1) + deviation(D, 1) <
+         deviation(a, 0) + deviation(b, 0) + deviation(C, 0) + deviation(D, 0);
 }
 
 inline bool
 DeformableMeshRemesher::TryFlip(IndexType c, bool lengthen)
 {
-  const int64_t o = m_O[c];
+  const Link o = m_O[c];
   if (o < 0)
   {
     return false;
@@ -1002,8 +1212,8 @@ DeformableMeshRemesher::TryFlip(IndexType c, bool lengthen)
   }
 
   // t = (a, D, C), u = (b, C, D).
-  const int64_t a1 = m_O[no]; // twin of a -> D
-  const int64_t b1 = m_O[nc]; // twin of b -> C
+  const Link a1 = m_O[no]; // twin of a -> D
+  const Link b1 = m_O[nc]; // twin of b -> C
   m_V[nc] = D;
   m_V[no] = C;
   m_O[c] = a1;
@@ -1027,52 +1237,76 @@ DeformableMeshRemesher::TryFlip(IndexType c, bool lengthen)
   ++m_Valence[C];
   ++m_Valence[D];
   ++m_Statistics.flips;
+  if (m_SweepInputs == SweepInputs::Valences)
+  {
+    // The valence test of every edge with one of the four as an end-point
+    // or an opposite vertex.
+    for (const IndexType v : { a, b, C, D })
+    {
+      this->RequeueFan(v);
+    }
+  }
+  else if (m_SweepInputs == SweepInputs::Lengths)
+  {
+    for (const IndexType k : { c, nc, pc, oc, no, po })
+    {
+      this->Requeue(k);
+    }
+  }
   return true;
 }
 
 inline void
 DeformableMeshRemesher::FlipPass()
 {
-  for (IndexType c = 0; c < m_V.size(); ++c)
-  {
-    if (m_V[c] == Invalid || m_O[c] < static_cast<int64_t>(c))
-    {
-      continue;
-    }
-    this->TryFlip(c);
-  }
+  this->Sweep(
+    SweepInputs::Valences,
+    [this](IndexType c) { return m_V[c] != Invalid && this->FlipImprovesValences(c); },
+    [this](IndexType c) {
+      if (m_V[c] != Invalid && m_O[c] >= static_cast<int64_t>(c))
+      {
+        this->TryFlip(c);
+      }
+    });
 }
 
 inline void
 DeformableMeshRemesher::Relax()
 {
-  const std::size_t        numberOfPoints = m_State.size();
-  std::vector<double>      moved(m_X);
+  const std::size_t     numberOfPoints = m_State.size();
+  std::vector<double> & moved = m_Moved;
+  moved.assign(m_X.begin(), m_X.end());
   std::atomic<std::size_t> relaxed{ 0 };
   this->ParallelFor(numberOfPoints, [&](std::size_t first, std::size_t last) {
-    std::vector<IndexType> m_RingA; // per block
-    std::vector<IndexType> m_CornersA;
+    std::vector<IndexType> ring; // per block
+    std::vector<IndexType> corners;
+    std::vector<double>    normals; // of the vertex's triangles, as they are
     std::size_t            count = 0;
     for (std::size_t i = first; i < last; ++i)
     {
-      if (m_State[i] != RemesherFree || !this->Ring(static_cast<IndexType>(i), m_RingA, &m_CornersA))
+      if (m_State[i] != RemesherFree || !this->Ring(static_cast<IndexType>(i), ring, &corners))
       {
         continue;
       }
       const double * p = m_X.data() + 3 * i;
       double         centroid[3] = { 0.0, 0.0, 0.0 };
       double         normal[3] = { 0.0, 0.0, 0.0 };
-      for (const IndexType w : m_RingA)
+      for (const IndexType w : ring)
       {
         for (unsigned int d = 0; d < 3; ++d)
         {
           centroid[d] += m_X[3 * static_cast<std::size_t>(w) + d];
         }
       }
-      for (const IndexType k : m_CornersA)
+      normals.resize(3 * corners.size());
+      for (std::size_t j = 0; j < corners.size(); ++j)
       {
-        double n[3];
-        this->TriangleNormal(m_V[k], m_V[Next(k)], m_V[Prev(k)], n);
+        const IndexType k = corners[j];
+        double *        n = normals.data() + 3 * j;
+        this->TriangleNormal(p,
+                             m_X.data() + 3 * static_cast<std::size_t>(m_V[Next(k)]),
+                             m_X.data() + 3 * static_cast<std::size_t>(m_V[Prev(k)]),
+                             n);
         for (unsigned int d = 0; d < 3; ++d)
         {
           normal[d] += n[d];
@@ -1088,7 +1322,7 @@ DeformableMeshRemesher::Relax()
       for (unsigned int d = 0; d < 3; ++d)
       {
         normal[d] /= length;
-        step[d] = centroid[d] / static_cast<double>(m_RingA.size()) - p[d];
+        step[d] = centroid[d] / static_cast<double>(ring.size()) - p[d];
         along += step[d] * normal[d];
       }
       double q[3];
@@ -1098,13 +1332,13 @@ DeformableMeshRemesher::Relax()
       }
       // Refuse a move that turns one of the vertex's triangles around.
       bool keeps = true;
-      for (const IndexType k : m_CornersA)
+      for (std::size_t j = 0; j < corners.size(); ++j)
       {
-        const double * q1 = m_X.data() + 3 * static_cast<std::size_t>(m_V[Next(k)]);
-        const double * q2 = m_X.data() + 3 * static_cast<std::size_t>(m_V[Prev(k)]);
-        double         before[3];
-        double         after[3];
-        this->TriangleNormal(p, q1, q2, before);
+        const IndexType k = corners[j];
+        const double *  q1 = m_X.data() + 3 * static_cast<std::size_t>(m_V[Next(k)]);
+        const double *  q2 = m_X.data() + 3 * static_cast<std::size_t>(m_V[Prev(k)]);
+        const double *  before = normals.data() + 3 * j;
+        double          after[3];
         this->TriangleNormal(q, q1, q2, after);
         if (!(before[0] * after[0] + before[1] * after[1] + before[2] * after[2] > 0.0))
         {
@@ -1125,14 +1359,12 @@ DeformableMeshRemesher::Relax()
 }
 
 inline bool
-DeformableMeshRemesher::MoveKeepsBand(IndexType v, const double * q, IndexType other)
+DeformableMeshRemesher::MoveKeepsBand(IndexType                      v,
+                                      const double *                 q,
+                                      IndexType                      other,
+                                      const std::vector<IndexType> & ring,
+                                      const std::vector<IndexType> & corners) const
 {
-  std::vector<IndexType> & ring = m_RingB;
-  std::vector<IndexType> & corners = m_CornersB;
-  if (m_State[v] != RemesherFree || !this->Ring(v, ring, &corners))
-  {
-    return false;
-  }
   for (const IndexType w : ring)
   {
     if (w == other)
@@ -1170,25 +1402,43 @@ inline void
 DeformableMeshRemesher::LengthenPass()
 {
   const double minimum = std::sqrt(m_Min2);
-  for (IndexType c = 0; c < m_V.size(); ++c)
-  {
+  // The moves keep every other edge of the two end-points within the band:
+  // no edge becomes short during the pass, so the short edges of the mesh
+  // before it are all there is to visit.
+  const auto shortEdge = [this](IndexType c) {
     if (m_V[c] == Invalid || m_O[c] < static_cast<int64_t>(c))
     {
-      continue;
+      return false;
+    }
+    const double length2 = this->Length2(m_V[c], m_V[Next(c)]);
+    return length2 < m_Min2 && length2 > 0.0;
+  };
+  this->Sweep(SweepInputs::None, shortEdge, [&](IndexType c) {
+    if (!shortEdge(c))
+    {
+      return;
     }
     const IndexType a = m_V[c];
     const IndexType b = m_V[Next(c)];
     const double    length2 = this->Length2(a, b);
-    if (!(length2 < m_Min2) || !(length2 > 0.0))
-    {
-      continue;
-    }
-    const double length = std::sqrt(length2);
-    double *     pa = m_X.data() + 3 * static_cast<std::size_t>(a);
-    double *     pb = m_X.data() + 3 * static_cast<std::size_t>(b);
-    const double u[3] = { (pb[0] - pa[0]) / length, (pb[1] - pa[1]) / length, (pb[2] - pa[2]) / length };
-    const double missing = 1.01 * minimum - length;
-    // Both end-points half the way, or one of them all the way.
+    const double    length = std::sqrt(length2);
+    double *        pa = m_X.data() + 3 * static_cast<std::size_t>(a);
+    double *        pb = m_X.data() + 3 * static_cast<std::size_t>(b);
+    const double    u[3] = { (pb[0] - pa[0]) / length, (pb[1] - pa[1]) / length, (pb[2] - pa[2]) / length };
+    const double    missing = 1.01 * minimum - length;
+    // Both end-points half the way, or one of them all the way. The rings of
+    // a and b are walked once, when first needed (nothing moves before the
+    // move made).
+    int        walked[2] = { -1, -1 };
+    const auto movable = [&](unsigned int which) {
+      if (walked[which] < 0)
+      {
+        const IndexType v = which == 0 ? a : b;
+        walked[which] = m_State[v] == RemesherFree &&
+                        this->Ring(v, which == 0 ? m_RingA : m_RingB, which == 0 ? &m_CornersA : &m_CornersB);
+      }
+      return walked[which] == 1;
+    };
     const double shares[3][2] = { { 0.5, 0.5 }, { 1.0, 0.0 }, { 0.0, 1.0 } };
     for (const auto & share : shares)
     {
@@ -1199,14 +1449,15 @@ DeformableMeshRemesher::LengthenPass()
         qa[d] = pa[d] - share[0] * missing * u[d];
         qb[d] = pb[d] + share[1] * missing * u[d];
       }
-      if ((share[0] == 0.0 || this->MoveKeepsBand(a, qa, b)) && (share[1] == 0.0 || this->MoveKeepsBand(b, qb, a)))
+      if ((share[0] == 0.0 || (movable(0) && this->MoveKeepsBand(a, qa, b, m_RingA, m_CornersA))) &&
+          (share[1] == 0.0 || (movable(1) && this->MoveKeepsBand(b, qb, a, m_RingB, m_CornersB))))
       {
         std::copy(qa, qa + 3, pa);
         std::copy(qb, qb + 3, pb);
         break;
       }
     }
-  }
+  });
 }
 
 inline void
@@ -1230,12 +1481,14 @@ DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<I
   {
     // Order: the input vertices kept, in order, each followed by the vertices
     // split from its edges (a counting sort on the input ancestor).
-    std::vector<IndexType> root(numberOfPoints);
+    std::vector<IndexType> & root = m_Root;
+    root.resize(numberOfPoints);
     for (std::size_t i = 0; i < numberOfPoints; ++i)
     {
       root[i] = i < m_InputPoints ? static_cast<IndexType>(i) : root[m_Parents[i]];
     }
-    std::vector<IndexType> start(m_InputPoints + 1, 0);
+    std::vector<IndexType> & start = m_Start;
+    start.assign(m_InputPoints + 1, 0);
     for (std::size_t i = 0; i < numberOfPoints; ++i)
     {
       if (m_State[i] != RemesherRemoved)
@@ -1250,9 +1503,12 @@ DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<I
     const IndexType          kept = start[m_InputPoints];
     std::vector<IndexType> & newIndex = m_NewIndex;
     newIndex.assign(numberOfPoints, Invalid);
-    std::vector<IndexType> parents(kept);
-    std::vector<uint8_t>   state(kept);
-    std::vector<int32_t>   valence(kept);
+    std::vector<IndexType> & parents = m_ScratchParents;
+    std::vector<uint8_t> &   state = m_ScratchState;
+    std::vector<int32_t> &   valence = m_ScratchValence;
+    parents.resize(kept);
+    state.resize(kept);
+    valence.resize(kept);
     coordinates.resize(3 * static_cast<std::size_t>(kept));
     for (std::size_t i = 0; i < numberOfPoints; ++i)
     {
@@ -1295,8 +1551,9 @@ DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<I
       }
     }
     triangles.resize(next);
-    std::vector<int64_t> opposite(next);
-    bool                 consistent = true;
+    std::vector<Link> & opposite = m_ScratchO;
+    opposite.resize(next);
+    bool consistent = true;
     for (std::size_t c = 0; c < numberOfCorners; ++c)
     {
       const IndexType nc = newCorner[c];
@@ -1305,7 +1562,7 @@ DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<I
         continue;
       }
       triangles[nc] = newIndex[m_V[c]];
-      const int64_t o = m_O[c];
+      const Link o = m_O[c];
       if (o < 0)
       {
         opposite[nc] = o;
@@ -1314,7 +1571,7 @@ DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<I
       {
         const IndexType no = newCorner[static_cast<std::size_t>(o)];
         consistent = consistent && no != Invalid;
-        opposite[nc] = no != Invalid ? static_cast<int64_t>(no) : NonManifold;
+        opposite[nc] = no != Invalid ? static_cast<Link>(no) : NonManifold;
       }
     }
     m_V.assign(triangles.begin(), triangles.end());
@@ -1337,7 +1594,7 @@ DeformableMeshRemesher::Edges(std::vector<uint64_t> & edges) const
   bool unique = true;
   for (std::size_t c = 0; c < m_V.size(); ++c)
   {
-    const int64_t o = m_O[c];
+    const Link o = m_O[c];
     if (o < 0 || static_cast<int64_t>(c) < o)
     {
       const uint64_t a = m_V[c];
@@ -1368,7 +1625,8 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
                              << m_MinimumRatio << " and " << m_MaximumRatio << ".");
   }
   if (triangles.size() % 3 != 0 || coordinates.size() < 3 * numberOfPoints ||
-      numberOfPoints >= std::numeric_limits<IndexType>::max() / 2)
+      numberOfPoints >= std::numeric_limits<IndexType>::max() / 2 ||
+      triangles.size() >= static_cast<std::size_t>(std::numeric_limits<Link>::max() / 2))
   {
     itkGenericExceptionMacro("DeformableMeshRemesher: " << triangles.size() << " triangle indices and "
                                                         << coordinates.size() << " coordinates for " << numberOfPoints
