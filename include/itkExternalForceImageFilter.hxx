@@ -22,6 +22,10 @@
 #include "itkMultiThreaderBase.h"
 #include "itkSampledGaussianSmoothing.h"
 
+#include <cstdint>
+#include <cstring>
+#include <type_traits>
+
 #include "itkMath.h"
 
 #include <algorithm>
@@ -203,7 +207,30 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::ComputeForceField(const Inp
       }
     }
   }
-  for (SizeValueType i = 0; i < n; ++i)
+  // Non-finite components are looked for only when there is one: the
+  // largest magnitude (IEEE bits without the sign: infinities and NaNs above
+  // every finite value) in a loop without branches.
+  using ComponentType = typename OutputPixelType::ValueType;
+  bool allFinite = false;
+  if constexpr (std::is_same_v<ComponentType, float> || std::is_same_v<ComponentType, double>)
+  {
+    using Bits = std::conditional_t<std::is_same_v<ComponentType, float>, uint32_t, uint64_t>;
+    constexpr Bits          magnitudeMask = ~(Bits{ 1 } << (8 * sizeof(Bits) - 1));
+    const ComponentType *   components = n > 0 ? f[0].GetDataPointer() : nullptr;
+    const SizeValueType     count = n * OutputPixelType::Dimension;
+    Bits                    largestBits = 0;
+    for (SizeValueType i = 0; i < count; ++i)
+    {
+      Bits bits;
+      std::memcpy(&bits, components + i, sizeof(bits));
+      bits &= magnitudeMask;
+      largestBits = bits > largestBits ? bits : largestBits;
+    }
+    ComponentType largest;
+    std::memcpy(&largest, &largestBits, sizeof(largest));
+    allFinite = std::isfinite(largest);
+  }
+  for (SizeValueType i = 0; i < n && !allFinite; ++i)
   {
     for (unsigned int k = 0; k < OutputPixelType::Dimension; ++k)
     {
@@ -360,17 +387,28 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::ForEachCentralDifference(co
       OffsetValueType       lower[ImageDimension];
       OffsetValueType       upper[ImageDimension];
       const OffsetValueType lineStart = LocateLine(line, size, stride, lower, upper);
-      double                derivative[ImageDimension];
-      for (SizeValueType x = 0; x < lineLength; ++x)
-      {
+      // Pixel x of the line, its neighbours along the line at lower0 and
+      // upper0 (0 at the ends).
+      const auto visit = [&](SizeValueType x, OffsetValueType lower0, OffsetValueType upper0) {
         const OffsetValueType i = lineStart + static_cast<OffsetValueType>(x);
-        lower[0] = x > 0 ? -1 : 0;
-        upper[0] = x + 1 < lineLength ? 1 : 0;
-        for (unsigned int d = 0; d < ImageDimension; ++d)
+        double                derivative[ImageDimension];
+        derivative[0] = (static_cast<double>(v[i + upper0]) - v[i + lower0]) * scale[0];
+        for (unsigned int d = 1; d < ImageDimension; ++d)
         {
           derivative[d] = (static_cast<double>(v[i + upper[d]]) - v[i + lower[d]]) * scale[d];
         }
         function(i, derivative);
+      };
+      // The ends, then the inner pixels in a loop of constant offsets (the
+      // compiler vectorises it).
+      visit(0, 0, lineLength > 1 ? 1 : 0);
+      for (SizeValueType x = 1; x + 1 < lineLength; ++x)
+      {
+        visit(x, -1, 1);
+      }
+      if (lineLength > 1)
+      {
+        visit(lineLength - 1, -1, 0);
       }
     },
     nullptr);

@@ -109,10 +109,11 @@ private:
 
     const auto *        pixels = image->GetBufferPointer();
     const SizeValueType n = region.GetNumberOfPixels();
-    // The largest squared length, in a loop without branches (vectorised): a
-    // non-finite component makes it infinite or NaN, and only then is the
-    // first such pixel looked for.
-    double largestSquared = 0.0;
+    // The largest squared length, without branches: four running maxima
+    // (a maximum of non-negative numbers does not depend on their order) of
+    // squared lengths whose NaN or infinity, from a non-finite component,
+    // propagates; only then is the first such pixel looked for.
+    double largest[4] = { 0.0, 0.0, 0.0, 0.0 };
     for (SizeValueType i = 0; i < n; ++i)
     {
       double squared = 0.0;
@@ -121,7 +122,13 @@ private:
         const double v = static_cast<double>(pixels[i][k]);
         squared += v * v;
       }
-      largestSquared = squared > largestSquared || squared != squared ? squared : largestSquared;
+      double & m = largest[i & 3];
+      m = squared > m || squared != squared ? squared : m;
+    }
+    double largestSquared = 0.0;
+    for (const double m : largest)
+    {
+      largestSquared = m > largestSquared || m != m ? m : largestSquared;
     }
     if (std::isfinite(largestSquared))
     {

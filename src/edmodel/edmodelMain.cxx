@@ -287,6 +287,16 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                   RequireAtLeast("--every", o.snapshotEvery, 1);
                   o.snapshotEverySet = true;
                 } });
+  t.push_back({ io,
+                "--repeat",
+                "N",
+                "for timing: compute the force field and the deformation N times in this process and report the "
+                "fastest run and the first (the result, the same each time, is written once)",
+                "1",
+                [&o](const std::string & s) {
+                  o.repeat = ParseUnsigned("--repeat", s);
+                  RequireAtLeast("--repeat", o.repeat, 1);
+                } });
 
   const std::string force =
     "External force field (ExternalForceImageFilter): gradient of |gradient of the smoothed image|";

@@ -211,6 +211,7 @@ struct SegmentOptions
   double       convergenceFraction{ defaults::ConvergenceFraction };
   unsigned int snapshotEvery{ defaults::SnapshotEvery };
   bool         snapshotEverySet{ false };
+  unsigned int repeat{ 1 }; // --repeat: the computation run this many times, for timing
 };
 
 struct DemoOptions

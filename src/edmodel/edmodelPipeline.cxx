@@ -519,7 +519,9 @@ RunSegment(const SegmentOptions & o, const GlobalOptions & global)
   }
 #endif
 
-  const DeformResult result = Deform(image, initial, o, progress, snapshot);
+  const DeformResult result = RunRepeated(o, progress, [&](Progress & runProgress, bool first) {
+    return Deform(image, initial, o, runProgress, first ? snapshot : SnapshotCallback());
+  });
   CheckFinalSurface(image, initial, result.mesh);
 
   if (!o.forceOutput.empty())

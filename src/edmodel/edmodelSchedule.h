@@ -179,6 +179,39 @@ ComputeForceField(const typename TForceFilter::InputImageType * image, const Seg
   return field;
 }
 
+// --- Timing ------------------------------------------------------------------
+
+/** --repeat N: calls compute(progress, true) (the run whose result is used:
+ * progress and snapshots), then compute(quiet, false) N - 1 more times with
+ * a silent progress, and notes the fastest and the first run's wall-clock
+ * time. A run in a fresh process pays for its first use of the code and the
+ * memory (page faults, lazy binding); the later runs show the computation
+ * alone, as a library call timed in a loop does. */
+template <typename TCompute>
+auto
+RunRepeated(const SegmentOptions & o, Progress & progress, const TCompute & compute)
+{
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  auto       result = compute(progress, true);
+  const double first = std::chrono::duration<double>(Clock::now() - start).count();
+  if (o.repeat <= 1)
+  {
+    return result;
+  }
+  double   fastest = first;
+  Progress quiet(true);
+  for (unsigned int run = 1; run < o.repeat; ++run)
+  {
+    const auto again = Clock::now();
+    static_cast<void>(compute(quiet, false));
+    fastest = std::min(fastest, std::chrono::duration<double>(Clock::now() - again).count());
+  }
+  progress.Note("--repeat " + std::to_string(o.repeat) + ": force field and deformation in " + Format(fastest, 3) +
+                " s at best (the first run " + Format(first, 3) + " s)");
+  return result;
+}
+
 // --- One level of the coarse-to-fine schedule -------------------------------
 
 /** The schedule's settings that hold for every level, resolved from the

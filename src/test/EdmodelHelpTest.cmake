@@ -39,7 +39,8 @@ foreach(option --sigma --scale --balloon --max-step --tolerance --init-sphere --
 endforeach()
 # Options with a value: documented with their default.
 foreach(option --sigma --scale --elasticity --rigidity --balloon --max-step --iterations --tolerance --window
-    --gvf-mu --gvf-iterations --sphere-resolution --every --threads --init-sphere --init-circle --circle-points)
+    --gvf-mu --gvf-iterations --sphere-resolution --every --threads --init-sphere --init-circle --circle-points
+    --repeat)
   edm_entry(entry ${option})
   if(NOT entry MATCHES "\\[default: [^]]+\\]")
     message(FATAL_ERROR "segment --help: ${option} without its default:${entry}")
