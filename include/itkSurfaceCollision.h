@@ -632,6 +632,55 @@ SharedVertexGap(const double * const * a, unsigned int i, const double * const *
   return std::min(ga, SegmentTriangleDistance(b[(j + 1) % 3], b[(j + 2) % 3], a));
 }
 
+/** The closed triangles a and b (3 points each) are at least d apart by a
+ * separating axis: the line of their centroids or the normal of either;
+ * false when none tells. A cheap test before TriangleDistance(): the pairs
+ * that the collision index cannot clear by their motion are mostly still
+ * apart along one of these axes. The projections are taken relative to
+ * a[0], with a margin of 1e-12 of the coordinates' magnitude for their
+ * rounding. */
+inline bool
+SeparatedBy(const double * const * a, const double * const * b, double d)
+{
+  double p[3][3], q[3][3];
+  double scale = 0.0;
+  for (unsigned int k = 0; k < 3; ++k)
+  {
+    Subtract(a[k], a[0], p[k]);
+    Subtract(b[k], a[0], q[k]);
+    for (unsigned int j = 0; j < 3; ++j)
+    {
+      scale = std::max({ scale, std::abs(p[k][j]), std::abs(q[k][j]) });
+    }
+  }
+  double axes[3][3], e1[3], e2[3];
+  for (unsigned int j = 0; j < 3; ++j)
+  {
+    axes[0][j] = (q[0][j] + q[1][j] + q[2][j]) - (p[0][j] + p[1][j] + p[2][j]);
+  }
+  Cross(p[1], p[2], axes[1]);
+  Subtract(q[1], q[0], e1);
+  Subtract(q[2], q[0], e2);
+  Cross(e1, e2, axes[2]);
+  for (const auto & axis : axes)
+  {
+    const double length = std::sqrt(Dot(axis, axis));
+    if (!(length > 0.0))
+    {
+      continue;
+    }
+    const double pa[3] = { Dot(p[0], axis), Dot(p[1], axis), Dot(p[2], axis) };
+    const double qb[3] = { Dot(q[0], axis), Dot(q[1], axis), Dot(q[2], axis) };
+    const double separation = std::max(std::min({ qb[0], qb[1], qb[2] }) - std::max({ pa[0], pa[1], pa[2] }),
+                                       std::min({ pa[0], pa[1], pa[2] }) - std::max({ qb[0], qb[1], qb[2] }));
+    if (separation / length - 1e-12 * scale >= d)
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
 /** Triangles t and u (3 vertex indices each) share a vertex. */
 inline bool
 ShareVertex(const uint32_t * t, const uint32_t * u)
@@ -1006,24 +1055,26 @@ StoreBox(const double * lower, const double * upper, double margin, float * box)
  * absolute motion, so that a surface that moves fast as a whole (a balloon)
  * needs no more work than one at rest. At a rebuild, at reference positions
  * r (the proposed positions y of that step):
- * - the candidate pairs: the pairs sharing no vertex closer than a radius
- *   R = d + 0.75 mean edge lengths (found with a uniform grid of the
- *   triangles' boxes widened by R/2), each with a lower bound of its
- *   distance at r (the larger of the bounding spheres' gap and the gap of
- *   the projections on the line of the centroids; the exact distance once a
- *   step needs it); every other pair is at least R apart at r. Each
- *   triangle's clearance is the smallest distance of its candidates, at most
- *   R, less d;
  * - a pyramid of cells: level 0 has cells of side s = R + 2 r99 (r99 the
  *   99th percentile of the triangles' radii, the largest distance from a
  *   triangle's centroid to its vertices), each triangle in the cell of its
  *   centroid, so that every candidate of a triangle of radius up to r99 is
  *   in one of the 27 cells around its own; level k has cells of side
  *   2^k s; the top level has at most two cells along each axis. The larger
- *   triangles (1 %, "large triangles") are in no cell: at every step each
- *   is tested against the triangles whose boxes at r come within d plus the
- *   largest distance between its displacement box and the box of all
- *   displacements (a grid of the boxes at r).
+ *   triangles (1 %, "large triangles") are in no cell;
+ * - the candidate pairs: the pairs sharing no vertex closer than a radius
+ *   R = d + 0.75 mean edge lengths (the pairs of triangles in neighbouring
+ *   level-0 cells, and for the large triangles a uniform grid of the
+ *   triangles' boxes widened by R/2), each with a lower bound of its
+ *   distance at r (the larger of the bounding spheres' gap and the gap of
+ *   the projections on the line of the centroids; the exact distance once a
+ *   step needs it); every other pair is at least R apart at r. Each
+ *   triangle's clearance is the smallest distance of its candidates, at most
+ *   R, less d. At every step each large triangle t is tested against its
+ *   candidates while the largest distance between its displacement box and
+ *   the box of all displacements stays below R - d (no other pair can come
+ *   within d), otherwise against the triangles whose boxes at r come within
+ *   d plus that distance (the grid).
  * At each step the displacement y - r of every vertex is taken, and for
  * every triangle the box of its vertices' displacements; the box of a cell
  * is the union of its triangles', and its neighbourhood box the union over
@@ -1048,7 +1099,8 @@ StoreBox(const double * lower, const double * upper, double margin, float * box)
  * Only the triangles whose rho_t reaches their clearance ("tested
  * triangles") have their candidate pairs looked at, each first against the
  * pair's own bound (the largest distance between the two triangles' boxes
- * against d(t, u) - d) and then exactly. A surface moving as a whole, or
+ * against d(t, u) - d) and then exactly (a separating axis, the line of the
+ * centroids or a normal, first: SeparatedBy()). A surface moving as a whole, or
  * settled, costs a pass over the points, one over the triangles and one
  * over the cells per step. Once some displacements are reduced the modified
  * triangles are tested against every triangle whose box swept from x to y
@@ -1200,6 +1252,15 @@ public:
     return m_Candidates.size() / 2;
   }
 
+  /** Triangles of the index too large for its cells (above 1.25 times the
+   * 99th percentile of the radii at the last rebuild), tested at every
+   * step, for diagnostics. */
+  SizeValueType
+  GetNumberOfLargeTriangles() const
+  {
+    return m_Large.size();
+  }
+
   /** The points whose displacement the last Constrain() reduced. */
   const std::vector<IndexType> &
   GetConstrainedPoints() const
@@ -1321,27 +1382,9 @@ public:
             {
               continue;
             }
-            const double motion = LargestDistance(bt, m_TriangleDelta.data() + 6 * u);
-            if (motion < static_cast<double>(m_CandidateGaps[c]) - d)
+            if (!this->CandidateMayViolate(t, c, LargestDistance(bt, m_TriangleDelta.data() + 6 * u), d))
             {
               continue;
-            }
-            if (!m_CandidateExact[c])
-            {
-              // The pair's exact distance at the reference, once per rebuild
-              // (each direction of a pair is an entry of its own triangle's
-              // list: no two threads write one entry).
-              const IndexType * vt = m_Triangles.data() + 3 * t;
-              const IndexType * vu = m_Triangles.data() + 3 * u;
-              const double *    r = m_Reference.data();
-              const double *    a[3] = { r + 3 * vt[0], r + 3 * vt[1], r + 3 * vt[2] };
-              const double *    b[3] = { r + 3 * vu[0], r + 3 * vu[1], r + 3 * vu[2] };
-              m_CandidateGaps[c] = RoundDown(SurfaceCollisionDetail::TriangleDistance(a, b));
-              m_CandidateExact[c] = 1;
-              if (motion < static_cast<double>(m_CandidateGaps[c]) - d)
-              {
-                continue;
-              }
             }
             if (this->Violates(t, u, x, y, d))
             {
@@ -1380,48 +1423,86 @@ public:
       // closer than d + the largest distance between t's displacement box
       // and the box of all displacements at the reference.
       m_NumberOfTestedTriangles += m_Large.size();
-      for (const IndexType t : m_Large)
-      {
-        const float * bt = m_TriangleDelta.data() + 6 * t;
-        for (IndexType k = m_SharedOffsets[t]; k < m_SharedOffsets[t + 1]; ++k)
+      const SizeValueType                                       largeBlocks = (m_Large.size() + 1023) / 1024;
+      std::vector<std::vector<std::pair<IndexType, IndexType>>> largeFound(largeBlocks);
+      parallel(m_Large.size(), [&](SizeValueType begin, SizeValueType end) {
+        auto &     out = largeFound[begin / 1024];
+        const auto report = [&out](SizeValueType t, SizeValueType u) {
+          out.emplace_back(static_cast<IndexType>(std::min(t, u)), static_cast<IndexType>(std::max(t, u)));
+        };
+        for (SizeValueType l = begin; l < end; ++l)
         {
-          const IndexType q = m_SharedOfTriangle[k];
-          const IndexType u = this->OtherOfShared(q, t);
-          if ((m_IsLarge[u] && u < t) || this->SharedPairClear(q, LargestDistance(bt, m_TriangleDelta.data() + 6 * u)))
+          const IndexType t = m_Large[l];
+          const float *   bt = m_TriangleDelta.data() + 6 * t;
+          for (IndexType k = m_SharedOffsets[t]; k < m_SharedOffsets[t + 1]; ++k)
           {
+            const IndexType q = m_SharedOfTriangle[k];
+            const IndexType u = this->OtherOfShared(q, t);
+            if ((m_IsLarge[u] && u < t) ||
+                this->SharedPairClear(q, LargestDistance(bt, m_TriangleDelta.data() + 6 * u)))
+            {
+              continue;
+            }
+            if (this->ViolatesShared(q, x, y, m_ContactDistance))
+            {
+              report(t, u);
+            }
+          }
+          // A pair that is no candidate was at least R apart at the
+          // reference, and moves by at most the largest distance between
+          // t's displacement box and the box of all displacements: while
+          // that stays below R - d only the candidates can come within d
+          // (the grid query at every step was the large triangles' cost on
+          // an uneven mesh).
+          const double globalMotion = LargestDistance(bt, m_GlobalDelta);
+          if (globalMotion < m_Radius - d)
+          {
+            for (SizeValueType c = m_CandidateOffsets[t]; c < m_CandidateOffsets[t + 1]; ++c)
+            {
+              const IndexType u = m_Candidates[c];
+              if (m_IsLarge[u] && u < t)
+              {
+                continue;
+              }
+              if (this->CandidateMayViolate(t, c, LargestDistance(bt, m_TriangleDelta.data() + 6 * u), d) &&
+                  this->Violates(t, u, x, y, d))
+              {
+                report(t, u);
+              }
+            }
             continue;
           }
-          if (this->ViolatesShared(q, x, y, m_ContactDistance))
-          {
-            violating.emplace_back(std::min(t, u), std::max(t, u));
-          }
+          // Otherwise every triangle whose box at the reference comes
+          // within d plus that motion.
+          double lo[3], hi[3];
+          TriangleBox(m_Reference.data(), m_Triangles.data() + 3 * t, lo, hi);
+          float query[6];
+          SurfaceCollisionDetail::StoreBox(lo, hi, globalMotion + d, query);
+          const double * st = m_Spheres.data() + 4 * t;
+          m_ReferenceGrid.ForEachOverlapOfBox(query, t, [&](SizeValueType u) {
+            if ((m_IsLarge[u] && u < t) ||
+                SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
+            {
+              return;
+            }
+            const double * su = m_Spheres.data() + 4 * u;
+            double         e[3];
+            SurfaceCollisionDetail::Subtract(st, su, e);
+            const double gap = std::sqrt(SurfaceCollisionDetail::Dot(e, e)) - st[3] - su[3];
+            if (LargestDistance(bt, m_TriangleDelta.data() + 6 * u) < gap - d)
+            {
+              return;
+            }
+            if (this->Violates(t, u, x, y, d))
+            {
+              report(t, u);
+            }
+          });
         }
-        const double reach = LargestDistance(bt, m_GlobalDelta) + d;
-        double       lo[3], hi[3];
-        TriangleBox(m_Reference.data(), m_Triangles.data() + 3 * t, lo, hi);
-        float query[6];
-        SurfaceCollisionDetail::StoreBox(lo, hi, reach, query);
-        const double * st = m_Spheres.data() + 4 * t;
-        m_ReferenceGrid.ForEachOverlapOfBox(query, t, [&](SizeValueType u) {
-          if ((m_IsLarge[u] && u < t) ||
-              SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
-          {
-            return;
-          }
-          const double * su = m_Spheres.data() + 4 * u;
-          double         e[3];
-          SurfaceCollisionDetail::Subtract(st, su, e);
-          const double gap = std::sqrt(SurfaceCollisionDetail::Dot(e, e)) - st[3] - su[3];
-          if (LargestDistance(bt, m_TriangleDelta.data() + 6 * u) < gap - d)
-          {
-            return;
-          }
-          if (this->Violates(t, u, x, y, d))
-          {
-            violating.emplace_back(static_cast<IndexType>(std::min<SizeValueType>(t, u)),
-                                   static_cast<IndexType>(std::max<SizeValueType>(t, u)));
-          }
-        });
+      });
+      for (const auto & block : largeFound)
+      {
+        violating.insert(violating.end(), block.begin(), block.end());
       }
     }
     else
@@ -1698,6 +1779,54 @@ private:
     return (i << (2 * KeyBits)) | (j << KeyBits) | k;
   }
 
+  /** The occupied cells among the 27 around each cell of \a level (itself
+   * included), in increasing order, and the cells' boxes sized. The keys
+   * are sorted and the three cells (dk = -1, 0, 1) of each of the 9
+   * columns (di, dj) around a cell are consecutive keys, growing with the
+   * cell's own: one cursor per column walks the keys once (27 binary
+   * searches per cell were a twentieth of a rebuild). */
+  static void
+  FindNeighbours(CellLevel & level)
+  {
+    const SizeValueType cells = level.keys.size();
+    const uint64_t      mask = (uint64_t{ 1 } << KeyBits) - 1;
+    SizeValueType       cursors[9] = {};
+    level.neighbourOffsets.assign(1, 0);
+    level.neighbours.clear();
+    for (SizeValueType s = 0; s < cells; ++s)
+    {
+      const uint64_t key = level.keys[s];
+      const uint64_t ci = (key >> (2 * KeyBits)) & mask;
+      const uint64_t cj = (key >> KeyBits) & mask;
+      const uint64_t ck = key & mask;
+      for (unsigned int column = 0; column < 9; ++column)
+      {
+        const int di = static_cast<int>(column / 3) - 1;
+        const int dj = static_cast<int>(column % 3) - 1;
+        // Level-0 coordinates start at 1; on coarser levels a coordinate 0
+        // has no lower neighbour.
+        if ((ci == 0 && di < 0) || (cj == 0 && dj < 0))
+        {
+          continue;
+        }
+        const uint64_t  first = Key(ci + di, cj + dj, ck == 0 ? 0 : ck - 1);
+        const uint64_t  last = Key(ci + di, cj + dj, ck + 1);
+        SizeValueType & cursor = cursors[column];
+        while (cursor < cells && level.keys[cursor] < first)
+        {
+          ++cursor;
+        }
+        for (SizeValueType c = cursor; c < cells && level.keys[c] <= last; ++c)
+        {
+          level.neighbours.push_back(static_cast<IndexType>(c));
+        }
+      }
+      level.neighbourOffsets.push_back(static_cast<IndexType>(level.neighbours.size()));
+    }
+    level.boxes.resize(6 * cells);
+    level.unions.resize(6 * cells);
+  }
+
   static void
   EmptyBox(float * box)
   {
@@ -1759,9 +1888,9 @@ private:
   /** Calls f(u) for every triangle u sharing no vertex with t that may
    * come within d of it while the displacements since the reference stay in
    * the boxes of the last Bound() (which held): t's candidates whose pair
-   * bound does not clear them and, when there are large triangles, the pairs
-   * of t with a large triangle found in the reference grid. Other pairs are
-   * kept apart by the cells' bounds. */
+   * bound does not clear them and, when there are large triangles and t's
+   * motion may reach R - d, the pairs of t with a large triangle found in
+   * the reference grid. Other pairs are kept apart by the cells' bounds. */
   template <typename TFunction>
   void
   ForEachBoundedPartner(SizeValueType t, double d, TFunction && f)
@@ -1776,11 +1905,15 @@ private:
       }
       f(u);
     }
-    if (m_Large.empty())
+    // The pairs with a large triangle that are no candidates were at least
+    // R apart at the reference: clear while t's motion against every
+    // displacement stays below R - d.
+    const double globalMotion = m_Large.empty() ? 0.0 : LargestDistance(bt, m_GlobalDelta);
+    if (m_Large.empty() || globalMotion < m_Radius - d)
     {
       return;
     }
-    const double reach = LargestDistance(bt, m_GlobalDelta) + d;
+    const double reach = globalMotion + d;
     double       lo[3], hi[3];
     TriangleBox(m_Reference.data(), m_Triangles.data() + 3 * t, lo, hi);
     float query[6];
@@ -1793,6 +1926,32 @@ private:
       }
       f(u);
     });
+  }
+
+  /** Candidate c of triangle t may violate when the relative motion of the
+   * pair is \a motion: the motion reaches the pair's gap at the reference
+   * less d, the exact distance computed once per rebuild when the cheap
+   * bound does not tell (each direction of a pair is an entry of its own
+   * triangle's list: no two threads write one entry). */
+  bool
+  CandidateMayViolate(SizeValueType t, SizeValueType c, double motion, double d)
+  {
+    if (motion < static_cast<double>(m_CandidateGaps[c]) - d)
+    {
+      return false;
+    }
+    if (m_CandidateExact[c])
+    {
+      return true;
+    }
+    const IndexType * vt = m_Triangles.data() + 3 * t;
+    const IndexType * vu = m_Triangles.data() + 3 * m_Candidates[c];
+    const double *    r = m_Reference.data();
+    const double *    a[3] = { r + 3 * vt[0], r + 3 * vt[1], r + 3 * vt[2] };
+    const double *    b[3] = { r + 3 * vu[0], r + 3 * vu[1], r + 3 * vu[2] };
+    m_CandidateGaps[c] = RoundDown(SurfaceCollisionDetail::TriangleDistance(a, b));
+    m_CandidateExact[c] = 1;
+    return !(motion < static_cast<double>(m_CandidateGaps[c]) - d);
   }
 
   /** The triangle of shared pair q other than t. */
@@ -1841,9 +2000,10 @@ private:
   /** A lower bound of SharedGap(q, x), cheap: the largest separation of
    * the far edge of one triangle and the other triangle along a few axes
    * (the line between the far edges' midpoints, the triangles' normals), the
-   * smaller of the two. */
+   * smaller of the two. Once both separations reach \a enough the other
+   * axes are not tried: the bound is then at least \a enough. */
   double
-  SharedGapLowerBound(SizeValueType q, const double * x) const
+  SharedGapLowerBound(SizeValueType q, const double * x, double enough = std::numeric_limits<double>::infinity()) const
   {
     const IndexType * vt = nullptr;
     const IndexType * vu = nullptr;
@@ -1857,43 +2017,52 @@ private:
     Subtract(x + 3 * vt[(i + 2) % 3], v, q1);
     Subtract(x + 3 * vu[(j + 1) % 3], v, r);
     Subtract(x + 3 * vu[(j + 2) % 3], v, s);
-    // The separation of the far edge {e0, e1} of one triangle from the
-    // other triangle {0, f0, f1} (coordinates relative to the shared vertex):
-    // the largest along the other triangle's normal, its two edges' normals
-    // in its plane at the shared vertex (pointing away from it), and the
-    // line from its far edge's midpoint to the far edge's midpoint.
-    const auto bound = [](const double * e0, const double * e1, const double * f0, const double * f1) {
-      double axes[4][3];
-      Cross(f0, f1, axes[0]);
-      Cross(f0, axes[0], axes[1]);
-      Cross(axes[0], f1, axes[2]);
-      for (unsigned int k = 0; k < 3; ++k)
-      {
-        axes[3][k] = (e0[k] + e1[k]) - (f0[k] + f1[k]);
-      }
-      double best = 0.0;
-      for (const auto & axis : axes)
-      {
-        const double length = std::sqrt(Dot(axis, axis));
-        if (!(length > 0.0))
-        {
-          continue;
-        }
-        const double e[2] = { Dot(axis, e0), Dot(axis, e1) };
-        const double f[2] = { Dot(axis, f0), Dot(axis, f1) };
-        const double above = std::min(e[0], e[1]) - std::max({ 0.0, f[0], f[1] });
-        const double below = std::min({ 0.0, f[0], f[1] }) - std::max(e[0], e[1]);
-        best = std::max(best, std::max(above, below) / length);
-      }
-      return best;
-    };
-    const double first = bound(p, q1, r, s);
-    const double second = bound(r, s, p, q1);
     // Rounding of the differences and projections: a margin relative to the
     // coordinates' magnitude.
     const double scale = std::sqrt(std::max({ Dot(p, p), Dot(q1, q1), Dot(r, r), Dot(s, s) })) + std::abs(v[0]) +
                          std::abs(v[1]) + std::abs(v[2]);
-    return std::max(0.0, std::min(first, second) - 1e-12 * scale);
+    const double margin = 1e-12 * scale;
+    const double target = enough + margin;
+    const double target2 = target * target;
+    // The separation of the far edge {e0, e1} of one triangle from the
+    // other triangle {0, f0, f1} (coordinates relative to the shared vertex):
+    // the largest along the other triangle's two edges' normals in its plane
+    // at the shared vertex (pointing away from it), the line from its far
+    // edge's midpoint to the far edge's midpoint and its normal; in squares
+    // over the axes' squared lengths, one square root at the end (these
+    // bounds are about a quarter of a rebuild).
+    const auto bound = [target2](const double * e0, const double * e1, const double * f0, const double * f1) {
+      double axes[4][3];
+      Cross(f0, f1, axes[3]);
+      Cross(f0, axes[3], axes[0]);
+      Cross(axes[3], f1, axes[1]);
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        axes[2][k] = (e0[k] + e1[k]) - (f0[k] + f1[k]);
+      }
+      double best = 0.0;
+      for (const auto & axis : axes)
+      {
+        const double length2 = Dot(axis, axis);
+        const double e[2] = { Dot(axis, e0), Dot(axis, e1) };
+        const double f[2] = { Dot(axis, f0), Dot(axis, f1) };
+        const double above = std::min(e[0], e[1]) - std::max({ 0.0, f[0], f[1] });
+        const double below = std::min({ 0.0, f[0], f[1] }) - std::max(e[0], e[1]);
+        const double separation = std::max(above, below);
+        if (separation > 0.0 && length2 > 0.0)
+        {
+          best = std::max(best, separation * separation / length2);
+          if (best >= target2)
+          {
+            break;
+          }
+        }
+      }
+      return std::sqrt(best);
+    };
+    const double first = bound(p, q1, r, s);
+    const double second = first > margin ? bound(r, s, p, q1) : 0.0;
+    return std::max(0.0, std::min(first, second) - margin);
   }
 
   /** Shared pair q cannot violate while the relative motion of its
@@ -1921,6 +2090,12 @@ private:
   bool
   ViolatesShared(SizeValueType q, const double * x, const double * y, double c) const
   {
+    // The cheap separating-axis bound first: most pairs that a step's
+    // motion does not clear are still far from folding.
+    if (this->SharedGapLowerBound(q, y, c) >= c)
+    {
+      return false;
+    }
     const double next = this->SharedGap(q, y);
     return next < c && next < this->SharedGap(q, x);
   }
@@ -1951,7 +2126,11 @@ private:
     }
     const double * a[3] = { y + 3 * vt[0], y + 3 * vt[1], y + 3 * vt[2] };
     const double * b[3] = { y + 3 * vu[0], y + 3 * vu[1], y + 3 * vu[2] };
-    const double   next = SurfaceCollisionDetail::TriangleDistance(a, b);
+    if (SurfaceCollisionDetail::SeparatedBy(a, b, d))
+    {
+      return false;
+    }
+    const double next = SurfaceCollisionDetail::TriangleDistance(a, b);
     if (next >= d)
     {
       return false;
@@ -2048,8 +2227,8 @@ private:
       }
     }
 
-    // Candidate pairs: boxes widened by R/2 that overlap, closer than R.
-    // The grid is kept for the large triangles' queries.
+    // The boxes at the reference widened by R/2: two triangles whose boxes
+    // do not overlap are at least R apart.
     std::vector<float> & boxes = m_ReferenceBoxes;
     boxes.resize(6 * numberOfTriangles);
     parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
@@ -2060,64 +2239,230 @@ private:
         SurfaceCollisionDetail::StoreBox(lo, hi, 0.5 * radius, boxes.data() + 6 * t);
       }
     });
-    SurfaceCollisionDetail::BoxGrid & grid = m_ReferenceGrid;
-    grid.Build(boxes.data(), numberOfTriangles);
+
+    // Level 0 of the pyramid of cells: cells of side R + 2 r99 (larger when
+    // the keys would not fit), each triangle in the cell of its centroid;
+    // the large triangles are in no cell.
+    double lower[3] = { std::numeric_limits<double>::infinity(),
+                        std::numeric_limits<double>::infinity(),
+                        std::numeric_limits<double>::infinity() };
+    double upper[3] = { -std::numeric_limits<double>::infinity(),
+                        -std::numeric_limits<double>::infinity(),
+                        -std::numeric_limits<double>::infinity() };
+    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+    {
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        lower[k] = std::min(lower[k], m_Spheres[4 * t + k]);
+        upper[k] = std::max(upper[k], m_Spheres[4 * t + k]);
+      }
+    }
+    double cellSize = (radius + 2.0 * typicalRadius) * (1.0 + 1e-9);
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      cellSize = std::max(cellSize, (upper[k] - lower[k]) / static_cast<double>((uint64_t{ 1 } << KeyBits) - 4));
+    }
+    if (!(cellSize > 0.0) || !std::isfinite(cellSize))
+    {
+      cellSize = 1.0; // a degenerate surface (every point at one place)
+    }
+    // The triangles sorted by the key of their cell (pairs of key and
+    // triangle, sorted as such: no indirection in the comparisons).
+    std::vector<std::pair<uint64_t, IndexType>> order;
+    order.reserve(numberOfTriangles - m_Large.size());
+    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+    {
+      if (m_IsLarge[t])
+      {
+        continue;
+      }
+      uint64_t c[3];
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        c[k] = static_cast<uint64_t>((m_Spheres[4 * t + k] - lower[k]) / cellSize) + 1;
+      }
+      order.emplace_back(Key(c[0], c[1], c[2]), static_cast<IndexType>(t));
+    }
+    std::sort(order.begin(), order.end());
+    m_Levels.clear();
+    m_Levels.emplace_back();
+    m_Levels[0].cellSize = cellSize;
+    m_CellOrder.resize(order.size());
+    m_CellOffsets.clear();
+    m_TriangleCell.assign(numberOfTriangles, std::numeric_limits<IndexType>::max());
+    for (SizeValueType i = 0; i < order.size(); ++i)
+    {
+      const IndexType t = order[i].second;
+      m_CellOrder[i] = t;
+      if (m_Levels[0].keys.empty() || m_Levels[0].keys.back() != order[i].first)
+      {
+        m_Levels[0].keys.push_back(order[i].first);
+        m_CellOffsets.push_back(static_cast<IndexType>(i));
+      }
+      m_TriangleCell[t] = static_cast<IndexType>(m_Levels[0].keys.size() - 1);
+    }
+    m_CellOffsets.push_back(static_cast<IndexType>(m_CellOrder.size()));
+    std::vector<std::pair<uint64_t, IndexType>>().swap(order);
+    FindNeighbours(m_Levels[0]);
+
+    // Candidate pairs, closer than R. Two triangles of level-0 cells are
+    // within R of each other only when their centroids are within
+    // R + 2 r99 <= the cell size: in neighbouring cells. So the pairs of
+    // cells are enumerated over each cell and the neighbours after it, the
+    // spheres copied in cell order (read in sequence). The large triangles,
+    // in no cell, query a grid of the boxes (kept for their tests at every
+    // step).
     struct Pair
     {
       IndexType t;
       IndexType u;
       float     gap;
     };
-    // The overlapping pairs of boxes, enumerated bucket by bucket (each
-    // pair once, the boxes read in sequence).
-    const SizeValueType            buckets = grid.GetNumberOfBuckets();
-    const SizeValueType            blocks = (buckets + 1023) / 1024;
-    std::vector<std::vector<Pair>> pairs(blocks);
-    parallel(buckets, [&](SizeValueType begin, SizeValueType end) {
-      auto & out = pairs[begin / 1024];
-      grid.ForEachPair(begin, end, [&](SizeValueType t, SizeValueType u) {
+    // The triangles' spheres, vertices, corners and boxes copied in cell
+    // order, so that the pairs of two cells read them in sequence.
+    const SizeValueType    celled = m_CellOrder.size();
+    std::vector<double>    cellSpheres(4 * celled);
+    std::vector<IndexType> cellTriangles(3 * celled);
+    std::vector<double>    cellCorners(9 * celled);
+    std::vector<float>     cellBoxes(6 * celled);
+    parallel(celled, [&](SizeValueType begin, SizeValueType end) {
+      for (SizeValueType i = begin; i < end; ++i)
+      {
+        const IndexType   t = m_CellOrder[i];
+        const IndexType * v = m_Triangles.data() + 3 * t;
+        std::copy_n(m_Spheres.data() + 4 * t, 4, cellSpheres.data() + 4 * i);
+        std::copy_n(v, 3, cellTriangles.data() + 3 * i);
+        for (unsigned int k = 0; k < 3; ++k)
         {
-          const IndexType * vt = m_Triangles.data() + 3 * t;
-          const double *    st = m_Spheres.data() + 4 * t;
-          const IndexType * vu = m_Triangles.data() + 3 * u;
-          if (SurfaceCollisionDetail::ShareVertex(vt, vu))
-          {
-            return;
-          }
-          // A lower bound of the distance: the larger of the bounding
-          // spheres' gap and the gap between the triangles' projections on
-          // the line of their centroids; the exact distance is computed
-          // when a step needs it (Constrain()).
-          const double * su = m_Spheres.data() + 4 * u;
-          double         e[3];
-          SurfaceCollisionDetail::Subtract(su, st, e);
-          const double centres2 = SurfaceCollisionDetail::Dot(e, e);
-          const double reach = radius + st[3] + su[3];
-          if (centres2 >= reach * reach * (1.0 + 1e-12))
-          {
-            return; // the spheres' gap alone is beyond the radius
-          }
-          const double centres = std::sqrt(centres2);
-          double       gap = centres - st[3] - su[3];
-          if (centres > 0.0)
-          {
-            double top = -std::numeric_limits<double>::infinity();
-            double bottom = std::numeric_limits<double>::infinity();
-            for (unsigned int k = 0; k < 3; ++k)
-            {
-              top = std::max(top, SurfaceCollisionDetail::Dot(x + 3 * vt[k], e));
-              bottom = std::min(bottom, SurfaceCollisionDetail::Dot(x + 3 * vu[k], e));
-            }
-            gap = std::max(gap, (bottom - top) / centres * (1.0 - 1e-12) - 1e-12 * centres);
-          }
-          if (gap >= radius)
-          {
-            return;
-          }
-          out.push_back({ static_cast<IndexType>(t), static_cast<IndexType>(u), RoundDown(std::max(gap, 0.0)) });
+          std::copy_n(x + 3 * v[k], 3, cellCorners.data() + 9 * i + 3 * k);
         }
-      });
+        std::copy_n(boxes.data() + 6 * t, 6, cellBoxes.data() + 6 * i);
+      }
     });
+    // A lower bound of the distance at the reference of a pair whose
+    // spheres come within R and that shares no vertex (spheres st, su,
+    // boxes bt, bu, corners a, b: 3 points each): the larger of the
+    // bounding spheres' gap and the gap between the triangles' projections
+    // on the line of their centroids (the exact distance is computed when a
+    // step needs it, Constrain()); the pair is a candidate when its boxes
+    // overlap and the bound is below R.
+    const auto consider = [radius](SizeValueType       t,
+                                   SizeValueType       u,
+                                   const double *      st,
+                                   const double *      su,
+                                   const float *       bt,
+                                   const float *       bu,
+                                   const double *      a,
+                                   const double *      b,
+                                   std::vector<Pair> & out) {
+      if (bt[0] > bu[3] || bu[0] > bt[3] || bt[1] > bu[4] || bu[1] > bt[4] || bt[2] > bu[5] || bu[2] > bt[5])
+      {
+        return;
+      }
+      double e[3];
+      SurfaceCollisionDetail::Subtract(su, st, e);
+      const double centres = std::sqrt(SurfaceCollisionDetail::Dot(e, e));
+      double       gap = centres - st[3] - su[3];
+      if (centres > 0.0)
+      {
+        double top = -std::numeric_limits<double>::infinity();
+        double bottom = std::numeric_limits<double>::infinity();
+        for (unsigned int k = 0; k < 3; ++k)
+        {
+          top = std::max(top, SurfaceCollisionDetail::Dot(a + 3 * k, e));
+          bottom = std::min(bottom, SurfaceCollisionDetail::Dot(b + 3 * k, e));
+        }
+        gap = std::max(gap, (bottom - top) / centres * (1.0 - 1e-12) - 1e-12 * centres);
+      }
+      if (gap >= radius)
+      {
+        return;
+      }
+      out.push_back({ static_cast<IndexType>(t), static_cast<IndexType>(u), RoundDown(std::max(gap, 0.0)) });
+    };
+    const CellLevel &              base = m_Levels[0];
+    const SizeValueType            baseCells = base.keys.size();
+    const SizeValueType            cellBlocks = (baseCells + 1023) / 1024;
+    std::vector<std::vector<Pair>> pairs(cellBlocks + 1);
+    parallel(baseCells, [&](SizeValueType begin, SizeValueType end) {
+      auto & out = pairs[begin / 1024];
+      for (SizeValueType s = begin; s < end; ++s)
+      {
+        for (IndexType c = base.neighbourOffsets[s]; c < base.neighbourOffsets[s + 1]; ++c)
+        {
+          const IndexType other = base.neighbours[c];
+          if (other < s)
+          {
+            continue;
+          }
+          for (IndexType i = m_CellOffsets[s]; i < m_CellOffsets[s + 1]; ++i)
+          {
+            const double * si = cellSpheres.data() + 4 * i;
+            for (IndexType j = other == s ? i + 1 : m_CellOffsets[other]; j < m_CellOffsets[other + 1]; ++j)
+            {
+              const double * sj = cellSpheres.data() + 4 * j;
+              const double   e0 = si[0] - sj[0];
+              const double   e1 = si[1] - sj[1];
+              const double   e2 = si[2] - sj[2];
+              const double   reach = radius + si[3] + sj[3];
+              // Spheres apart by more than R, or a shared vertex (half of
+              // the pairs whose spheres come within R): no candidate.
+              if (e0 * e0 + e1 * e1 + e2 * e2 >= reach * reach * (1.0 + 1e-12) ||
+                  SurfaceCollisionDetail::ShareVertex(cellTriangles.data() + 3 * i, cellTriangles.data() + 3 * j))
+              {
+                continue;
+              }
+              consider(m_CellOrder[i],
+                       m_CellOrder[j],
+                       si,
+                       sj,
+                       cellBoxes.data() + 6 * i,
+                       cellBoxes.data() + 6 * j,
+                       cellCorners.data() + 9 * i,
+                       cellCorners.data() + 9 * j,
+                       out);
+            }
+          }
+        }
+      }
+    });
+    if (m_Large.empty())
+    {
+      m_ReferenceGrid.Clear();
+    }
+    else
+    {
+      m_ReferenceGrid.Build(boxes.data(), numberOfTriangles);
+      auto &     out = pairs[cellBlocks];
+      const auto corners = [x](const IndexType * v, double * c) {
+        for (unsigned int k = 0; k < 3; ++k)
+        {
+          std::copy_n(x + 3 * v[k], 3, c + 3 * k);
+        }
+      };
+      for (const IndexType t : m_Large)
+      {
+        const IndexType * vt = m_Triangles.data() + 3 * t;
+        const double *    st = m_Spheres.data() + 4 * t;
+        double            a[9];
+        corners(vt, a);
+        m_ReferenceGrid.ForEachOverlapOfBox(boxes.data() + 6 * t, t, [&](SizeValueType u) {
+          const IndexType * vu = m_Triangles.data() + 3 * u;
+          const double *    su = m_Spheres.data() + 4 * u;
+          double            e[3];
+          SurfaceCollisionDetail::Subtract(su, st, e);
+          const double reach = radius + st[3] + su[3];
+          if ((m_IsLarge[u] && u < t) || SurfaceCollisionDetail::ShareVertex(vt, vu) ||
+              SurfaceCollisionDetail::Dot(e, e) >= reach * reach * (1.0 + 1e-12))
+          {
+            return;
+          }
+          double b[9];
+          corners(vu, b);
+          consider(t, u, st, su, boxes.data() + 6 * t, boxes.data() + 6 * u, a, b, out);
+        });
+      }
+    }
     m_CandidateOffsets.assign(numberOfTriangles + 1, 0);
     for (const auto & block : pairs)
     {
@@ -2165,7 +2510,8 @@ private:
       for (SizeValueType q = begin; q < end; ++q)
       {
         m_SharedExact[q] = 0;
-        m_SharedGaps[q] = RoundDown(this->SharedGapLowerBound(q, x));
+        // Beyond R the bound does not lower any clearance (at most R - d).
+        m_SharedGaps[q] = RoundDown(this->SharedGapLowerBound(q, x, radius));
       }
     });
     parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
@@ -2179,69 +2525,6 @@ private:
       }
     });
 
-    // The pyramid of cells. Level 0: cells of side R + 2 r99 (larger when
-    // the keys would not fit), each triangle in the cell of its centroid;
-    // the large triangles are in no cell.
-    double lower[3] = { std::numeric_limits<double>::infinity(),
-                        std::numeric_limits<double>::infinity(),
-                        std::numeric_limits<double>::infinity() };
-    double upper[3] = { -std::numeric_limits<double>::infinity(),
-                        -std::numeric_limits<double>::infinity(),
-                        -std::numeric_limits<double>::infinity() };
-    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
-    {
-      for (unsigned int k = 0; k < 3; ++k)
-      {
-        lower[k] = std::min(lower[k], m_Spheres[4 * t + k]);
-        upper[k] = std::max(upper[k], m_Spheres[4 * t + k]);
-      }
-    }
-    double cellSize = (radius + 2.0 * typicalRadius) * (1.0 + 1e-9);
-    for (unsigned int k = 0; k < 3; ++k)
-    {
-      cellSize = std::max(cellSize, (upper[k] - lower[k]) / static_cast<double>((uint64_t{ 1 } << KeyBits) - 4));
-    }
-    if (!(cellSize > 0.0) || !std::isfinite(cellSize))
-    {
-      cellSize = 1.0; // a degenerate surface (every point at one place)
-    }
-    std::vector<uint64_t> coordinates(3 * numberOfTriangles);
-    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
-    {
-      for (unsigned int k = 0; k < 3; ++k)
-      {
-        coordinates[3 * t + k] = static_cast<uint64_t>((m_Spheres[4 * t + k] - lower[k]) / cellSize) + 1;
-      }
-    }
-    m_CellOrder.clear();
-    std::vector<uint64_t> keys(numberOfTriangles);
-    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
-    {
-      keys[t] = Key(coordinates[3 * t], coordinates[3 * t + 1], coordinates[3 * t + 2]);
-      if (!m_IsLarge[t])
-      {
-        m_CellOrder.push_back(static_cast<IndexType>(t));
-      }
-    }
-    std::sort(m_CellOrder.begin(), m_CellOrder.end(), [&keys](IndexType a, IndexType b) {
-      return keys[a] < keys[b] || (keys[a] == keys[b] && a < b);
-    });
-    m_Levels.clear();
-    m_Levels.emplace_back();
-    m_Levels[0].cellSize = cellSize;
-    m_CellOffsets.clear();
-    m_TriangleCell.assign(numberOfTriangles, std::numeric_limits<IndexType>::max());
-    for (SizeValueType i = 0; i < m_CellOrder.size(); ++i)
-    {
-      const IndexType t = m_CellOrder[i];
-      if (m_Levels[0].keys.empty() || m_Levels[0].keys.back() != keys[t])
-      {
-        m_Levels[0].keys.push_back(keys[t]);
-        m_CellOffsets.push_back(static_cast<IndexType>(i));
-      }
-      m_TriangleCell[t] = static_cast<IndexType>(m_Levels[0].keys.size() - 1);
-    }
-    m_CellOffsets.push_back(static_cast<IndexType>(m_CellOrder.size()));
     // Coarser levels until every cell neighbours every other.
     const uint64_t mask = (uint64_t{ 1 } << KeyBits) - 1;
     const auto     spread = [mask](const std::vector<uint64_t> & levelKeys) {
@@ -2280,43 +2563,7 @@ private:
           std::lower_bound(coarser.keys.begin(), coarser.keys.end(), parentKeys[s]) - coarser.keys.begin());
       }
       m_Levels.push_back(std::move(coarser));
-    }
-    for (CellLevel & level : m_Levels)
-    {
-      const SizeValueType cells = level.keys.size();
-      level.neighbourOffsets.assign(1, 0);
-      level.neighbours.clear();
-      for (SizeValueType s = 0; s < cells; ++s)
-      {
-        const uint64_t key = level.keys[s];
-        const uint64_t ci = (key >> (2 * KeyBits)) & mask;
-        const uint64_t cj = (key >> KeyBits) & mask;
-        const uint64_t ck = key & mask;
-        for (int di = -1; di <= 1; ++di)
-        {
-          for (int dj = -1; dj <= 1; ++dj)
-          {
-            for (int dk = -1; dk <= 1; ++dk)
-            {
-              // Level-0 coordinates start at 1; on coarser levels a
-              // coordinate 0 has no lower neighbour.
-              if ((ci == 0 && di < 0) || (cj == 0 && dj < 0) || (ck == 0 && dk < 0))
-              {
-                continue;
-              }
-              const uint64_t neighbour = Key(ci + di, cj + dj, ck + dk);
-              const auto     it = std::lower_bound(level.keys.begin(), level.keys.end(), neighbour);
-              if (it != level.keys.end() && *it == neighbour)
-              {
-                level.neighbours.push_back(static_cast<IndexType>(it - level.keys.begin()));
-              }
-            }
-          }
-        }
-        level.neighbourOffsets.push_back(static_cast<IndexType>(level.neighbours.size()));
-      }
-      level.boxes.resize(6 * cells);
-      level.unions.resize(6 * cells);
+      FindNeighbours(m_Levels.back());
     }
     // The largest triangle radius of each cell and of the 27 around it.
     m_Levels[0].radii.assign(m_Levels[0].keys.size(), 0.0);

@@ -656,29 +656,32 @@ TEST(SurfaceCollision, ConstrainStopsFrontsPushedThroughEachOther)
   EXPECT_GE(second.smallestDistance, d);
 }
 
-TEST(SurfaceCollision, RandomStepsNeverBringPairsCloserThanD)
+namespace
 {
-  // Two parallel sheets 1 apart (edges 0.5), 80 steps of random smooth
-  // displacements that push them through each other and back, with a
-  // tangential wave and every fifth and sixth step a translation of the whole
-  // surface by 1.9 (four times the index's radius). After every Constrain():
-  // no intersecting pair and no pair closer than d, by this file's all-pairs
-  // test. A translation moves no triangle relative to another: the second of
-  // two translations keeps the index (the first may follow a rebuild).
-  std::vector<double>   x;
-  std::vector<uint32_t> triangles;
-  TwoSheets(1.0, x, triangles);
-  const std::size_t n = x.size() / 3;
-  const double      d = 0.1;
-  ASSERT_GE(CheckAllPairs(x, triangles, d).smallestDistance, d);
+/** Statistics of RandomSteps(). */
+struct RandomStepsResult
+{
+  unsigned int constrainedSteps{ 0 };
+  unsigned int keptIndex{ 0 };
+  unsigned int secondTranslations{ 0 };
+  unsigned int secondTranslationRebuilds{ 0 };
+  std::size_t  largeTriangles{ 0 }; // most seen after a Constrain()
+};
+
+/** 80 steps of random smooth displacements of the two sheets of \a x that
+ * push them through each other and back, with a tangential wave and every
+ * fifth and sixth step a translation of the whole surface by 1.9; after
+ * every Constrain() (minimum distance \a d) no intersecting pair and no
+ * pair closer than d, by this file's all-pairs test. */
+RandomStepsResult
+RandomSteps(std::vector<double> x, const std::vector<uint32_t> & triangles, double d)
+{
+  RandomStepsResult     stats;
+  const std::size_t     n = x.size() / 3;
   itk::SurfaceCollision collision;
   collision.SetSurface(n, triangles.data(), triangles.size() / 3);
   std::mt19937                           random(20261202);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  unsigned int                           constrainedSteps = 0;
-  unsigned int                           keptIndex = 0;
-  unsigned int                           secondTranslations = 0;
-  unsigned int                           secondTranslationRebuilds = 0;
   for (unsigned int step = 0; step < 80; ++step)
   {
     std::vector<double> y = x;
@@ -709,21 +712,103 @@ TEST(SurfaceCollision, RandomStepsNeverBringPairsCloserThanD)
     }
     const auto       result = collision.Constrain(x.data(), y.data(), d, nullptr, 1);
     const BruteForce check = CheckAllPairs(y, triangles, d);
-    ASSERT_EQ(check.intersecting, 0u) << "step " << step;
-    ASSERT_GE(check.smallestDistance, d - 1e-9) << "step " << step;
-    constrainedSteps += result.constrained > 0 ? 1 : 0;
-    keptIndex += result.rebuilt ? 0 : 1;
+    EXPECT_EQ(check.intersecting, 0u) << "step " << step;
+    EXPECT_GE(check.smallestDistance, d - 1e-9) << "step " << step;
+    if (check.intersecting != 0 || !(check.smallestDistance >= d - 1e-9))
+    {
+      return stats;
+    }
+    stats.constrainedSteps += result.constrained > 0 ? 1 : 0;
+    stats.keptIndex += result.rebuilt ? 0 : 1;
+    stats.largeTriangles = std::max<std::size_t>(stats.largeTriangles, collision.GetNumberOfLargeTriangles());
     if (step % 6 == 5)
     {
-      ++secondTranslations;
-      secondTranslationRebuilds += result.rebuilt ? 1 : 0;
+      ++stats.secondTranslations;
+      stats.secondTranslationRebuilds += result.rebuilt ? 1 : 0;
     }
     x = y;
   }
-  EXPECT_GE(constrainedSteps, 10u) << "the sheets were pushed into each other";
-  EXPECT_GE(keptIndex, 20u) << "the index served several steps";
-  EXPECT_EQ(secondTranslationRebuilds, 0u) << "of " << secondTranslations << " second translations";
-  std::cout << constrainedSteps << " steps constrained, the index kept at " << keptIndex << " of 80 steps" << std::endl;
+  return stats;
+}
+} // namespace
+
+TEST(SurfaceCollision, RandomStepsNeverBringPairsCloserThanD)
+{
+  // Two parallel sheets 1 apart (edges 0.5), RandomSteps() with d = 0.1.
+  // A translation moves no triangle relative to another: the second of two
+  // translations keeps the index (the first may follow a rebuild).
+  std::vector<double>   x;
+  std::vector<uint32_t> triangles;
+  TwoSheets(1.0, x, triangles);
+  const double d = 0.1;
+  ASSERT_GE(CheckAllPairs(x, triangles, d).smallestDistance, d);
+  const RandomStepsResult stats = RandomSteps(x, triangles, d);
+  EXPECT_GE(stats.constrainedSteps, 10u) << "the sheets were pushed into each other";
+  EXPECT_GE(stats.keptIndex, 20u) << "the index served several steps";
+  EXPECT_EQ(stats.secondTranslationRebuilds, 0u) << "of " << stats.secondTranslations << " second translations";
+  EXPECT_EQ(stats.largeTriangles, 0u) << "an even mesh: every triangle in the cells";
+  std::cout << stats.constrainedSteps << " steps constrained, the index kept at " << stats.keptIndex << " of 80 steps"
+            << std::endl;
+}
+
+TEST(SurfaceCollision, RandomStepsWithLargeTrianglesNeverBringPairsCloserThanD)
+{
+  // The same with one corner of each sheet pulled out by (1.5, -1.5): the
+  // one triangle at that corner of each sheet is several times larger than
+  // the others, in no cell of the index (a large triangle): its pairs are
+  // found through the grid of boxes, at the rebuilds and at every step.
+  std::vector<double>   x;
+  std::vector<uint32_t> triangles;
+  TwoSheets(1.0, x, triangles);
+  const std::size_t n = x.size() / 3;
+  for (const std::size_t corner : { std::size_t{ 12 }, n / 2 + 12 })
+  {
+    x[3 * corner] += 1.5;
+    x[3 * corner + 1] -= 1.5;
+  }
+  const double d = 0.1;
+  ASSERT_GE(CheckAllPairs(x, triangles, d).smallestDistance, d);
+  const RandomStepsResult stats = RandomSteps(x, triangles, d);
+  EXPECT_GE(stats.constrainedSteps, 10u) << "the sheets were pushed into each other";
+  EXPECT_EQ(stats.largeTriangles, 2u) << "the two corner triangles";
+}
+
+TEST(SurfaceCollision, ALargeTriangleMovingAloneStopsAtD)
+{
+  // Two sheets 0.3 apart (d = 0.1) with the same corner of each pulled out
+  // by (1.5, -1.5): two large triangles, one above the other. Only the
+  // lower one's pulled-out corner rises, by 0.05 a step: no triangle of any
+  // cell moves, so only the large triangles' test at every step can see the
+  // pair come closer (while the motion is below R - d, through their
+  // candidate pairs). Unconstrained, the corner would pass the upper sheet.
+  std::vector<double>   x;
+  std::vector<uint32_t> triangles;
+  TwoSheets(0.3, x, triangles);
+  const std::size_t n = x.size() / 3;
+  for (const std::size_t corner : { std::size_t{ 12 }, n / 2 + 12 })
+  {
+    x[3 * corner] += 1.5;
+    x[3 * corner + 1] -= 1.5;
+  }
+  const double d = 0.1;
+  ASSERT_GE(CheckAllPairs(x, triangles, d).smallestDistance, d);
+  itk::SurfaceCollision collision;
+  collision.SetSurface(n, triangles.data(), triangles.size() / 3);
+  double unconstrained = std::numeric_limits<double>::infinity();
+  for (unsigned int step = 0; step < 10; ++step)
+  {
+    std::vector<double> y = x;
+    y[3 * 12 + 2] += 0.05;
+    unconstrained = std::min(unconstrained, CheckAllPairs(y, triangles, d).smallestDistance);
+    collision.Constrain(x.data(), y.data(), d, nullptr, 1);
+    EXPECT_EQ(collision.GetNumberOfLargeTriangles(), 2u);
+    const BruteForce check = CheckAllPairs(y, triangles, d);
+    ASSERT_EQ(check.intersecting, 0u) << "step " << step;
+    ASSERT_GE(check.smallestDistance, d - 1e-9) << "step " << step;
+    x = y;
+  }
+  EXPECT_LT(unconstrained, d) << "the proposed steps would have come within d";
+  EXPECT_LT(x[3 * 12 + 2], 0.3) << "the corner stopped below the upper sheet";
 }
 
 // ---------------------------------------------------------------------------
