@@ -234,7 +234,9 @@ FromMesh(const ContourMeshType * mesh, const Contours & layout)
   return result;
 }
 
-/** The contours as a 3-D mesh (z = 0) of line cells, for the .pvd series. */
+#ifdef EDM_HAVE_VTK
+/** The contours as a 3-D mesh (z = 0) of line cells, for the .pvd series (a build
+ * with VTK). */
 MeshType::Pointer
 ToSurfaceMesh(const Contours & contours)
 {
@@ -264,6 +266,7 @@ ToSurfaceMesh(const Contours & contours)
   }
   return mesh;
 }
+#endif
 
 /** A contour with too few points, or points that are not finite, is bad
  * input. */
