@@ -1088,7 +1088,7 @@ DeformableMeshFilter<TMesh, TForceImage>::FinishStep(const double *        start
     const double along = d[0] * normals[4 * i] + d[1] * normals[4 * i + 1] + d[2] * normals[4 * i + 2];
     return along * along;
   };
-  MultiThreaderBase *        threader = this->GetMultiThreader();
+  MultiThreaderBase * threader = this->GetMultiThreader();
   threader->ParallelizeArray(
     0,
     numberOfBlocks,

@@ -215,10 +215,10 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::ComputeForceField(const Inp
   if constexpr (std::is_same_v<ComponentType, float> || std::is_same_v<ComponentType, double>)
   {
     using Bits = std::conditional_t<std::is_same_v<ComponentType, float>, uint32_t, uint64_t>;
-    constexpr Bits          magnitudeMask = ~(Bits{ 1 } << (8 * sizeof(Bits) - 1));
-    const ComponentType *   components = n > 0 ? f[0].GetDataPointer() : nullptr;
-    const SizeValueType     count = n * OutputPixelType::Dimension;
-    Bits                    largestBits = 0;
+    constexpr Bits        magnitudeMask = ~(Bits{ 1 } << (8 * sizeof(Bits) - 1));
+    const ComponentType * components = n > 0 ? f[0].GetDataPointer() : nullptr;
+    const SizeValueType   count = n * OutputPixelType::Dimension;
+    Bits                  largestBits = 0;
     for (SizeValueType i = 0; i < count; ++i)
     {
       Bits bits;

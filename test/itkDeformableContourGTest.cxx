@@ -768,9 +768,9 @@ TEST(DeformableContour, StepBoundAndConvergence)
 // than the tolerance, and both contours lie on the circle.
 TEST(DeformableContour, ConvergenceAlongNormalsIgnoresPointsSlidingAlongTheContour)
 {
-  const PointType center = Point(24.3, 23.8);
-  const auto      image = MakeImage(UnitGeometry(48), center, InsideEllipse(center, 14.0, 14.0, 0.0));
-  const auto      forces = Forces(image, 1.0, false);
+  const PointType        center = Point(24.3, 23.8);
+  const auto             image = MakeImage(UnitGeometry(48), center, InsideEllipse(center, 14.0, 14.0, 0.0));
+  const auto             forces = Forces(image, 1.0, false);
   constexpr unsigned int n = 120;
   auto                   uneven = MeshType::New();
   for (unsigned int k = 0; k < n; ++k)
@@ -787,7 +787,7 @@ TEST(DeformableContour, ConvergenceAlongNormalsIgnoresPointsSlidingAlongTheConto
   }
   uneven->SetCell(0, cell);
 
-  constexpr double tolerance = 0.002;
+  constexpr double   tolerance = 0.002;
   itk::SizeValueType iterations[2] = { 0, 0 };
   for (const bool alongNormals : { false, true })
   {

@@ -1180,10 +1180,9 @@ RunSegmentContour(const SegmentOptions & o, const GlobalOptions & global)
   }
 #endif
 
-  const ContourResult result =
-    RunRepeated(o, progress, [&](Progress & runProgress, bool first) {
-      return DeformContours(image, initial, o, runProgress, first ? snapshot : ContourSnapshot());
-    });
+  const ContourResult result = RunRepeated(o, progress, [&](Progress & runProgress, bool first) {
+    return DeformContours(image, initial, o, runProgress, first ? snapshot : ContourSnapshot());
+  });
   // Levels refine the contours: compare with the initial ones contour by
   // contour (the same layout).
   CheckFinalContours(image, initial, result.contours);

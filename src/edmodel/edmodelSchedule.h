@@ -192,8 +192,8 @@ auto
 RunRepeated(const SegmentOptions & o, Progress & progress, const TCompute & compute)
 {
   using Clock = std::chrono::steady_clock;
-  const auto start = Clock::now();
-  auto       result = compute(progress, true);
+  const auto   start = Clock::now();
+  auto         result = compute(progress, true);
   const double first = std::chrono::duration<double>(Clock::now() - start).count();
   if (o.repeat <= 1)
   {
