@@ -302,6 +302,22 @@ TwoSheets(double gap, std::vector<double> & x, std::vector<uint32_t> & triangles
     }
   }
 }
+
+/** TwoSheets() with the same corner of each sheet (point 12, the end of
+ * the first row) pulled out by (1.5, -1.5): the one triangle at that corner
+ * of each sheet is several times larger than the others (a large triangle
+ * of the index, in no cell). */
+void
+TwoSheetsWithLargeCorners(double gap, std::vector<double> & x, std::vector<uint32_t> & triangles)
+{
+  TwoSheets(gap, x, triangles);
+  const std::size_t n = x.size() / 3;
+  for (const std::size_t corner : { std::size_t{ 12 }, n / 2 + 12 })
+  {
+    x[3 * corner] += 1.5;
+    x[3 * corner + 1] -= 1.5;
+  }
+}
 } // namespace
 
 // ---------------------------------------------------------------------------
@@ -759,13 +775,7 @@ TEST(SurfaceCollision, RandomStepsWithLargeTrianglesNeverBringPairsCloserThanD)
   // found through the grid of boxes, at the rebuilds and at every step.
   std::vector<double>   x;
   std::vector<uint32_t> triangles;
-  TwoSheets(1.0, x, triangles);
-  const std::size_t n = x.size() / 3;
-  for (const std::size_t corner : { std::size_t{ 12 }, n / 2 + 12 })
-  {
-    x[3 * corner] += 1.5;
-    x[3 * corner + 1] -= 1.5;
-  }
+  TwoSheetsWithLargeCorners(1.0, x, triangles);
   const double d = 0.1;
   ASSERT_GE(CheckAllPairs(x, triangles, d).smallestDistance, d);
   const RandomStepsResult stats = RandomSteps(x, triangles, d);
@@ -783,14 +793,9 @@ TEST(SurfaceCollision, ALargeTriangleMovingAloneStopsAtD)
   // candidate pairs). Unconstrained, the corner would pass the upper sheet.
   std::vector<double>   x;
   std::vector<uint32_t> triangles;
-  TwoSheets(0.3, x, triangles);
+  TwoSheetsWithLargeCorners(0.3, x, triangles);
   const std::size_t n = x.size() / 3;
-  for (const std::size_t corner : { std::size_t{ 12 }, n / 2 + 12 })
-  {
-    x[3 * corner] += 1.5;
-    x[3 * corner + 1] -= 1.5;
-  }
-  const double d = 0.1;
+  const double      d = 0.1;
   ASSERT_GE(CheckAllPairs(x, triangles, d).smallestDistance, d);
   itk::SurfaceCollision collision;
   collision.SetSurface(n, triangles.data(), triangles.size() / 3);
