@@ -267,7 +267,11 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::Smooth(const InputImageType
 
   typename RealImageType::Pointer current = makeImage();
   {
-    // The largest |intensity| and the first non-finite pixel, chunk by chunk.
+    // The largest |intensity| and the first non-finite pixel, chunk by chunk:
+    // the largest magnitude without branches (a loop the compiler
+    // vectorises), the non-finite pixel looked for only when the largest is
+    // not finite (infinities and NaNs propagate through the comparisons
+    // written so).
     const auto *        in = input->GetBufferPointer();
     std::vector<double> largest(numberOfChunks, 0.0);
     std::vector<double> firstNonFinite(numberOfChunks, -1.0);
@@ -277,15 +281,44 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::Smooth(const InputImageType
       [&](SizeValueType c) {
         const SizeValueType end = std::min(numberOfPixels, (c + 1) * chunk);
         double              m = 0.0;
-        for (SizeValueType i = c * chunk; i < end; ++i)
+        using InputValueType = typename InputImageType::PixelType;
+        if constexpr (std::is_same_v<InputValueType, float> || std::is_same_v<InputValueType, double>)
         {
-          const double v = std::abs(static_cast<double>(in[i]));
-          if (!(v <= std::numeric_limits<double>::max()))
+          // The largest of the values' bits without the sign: for IEEE
+          // numbers the order of their magnitudes, infinities and NaNs above
+          // every finite value (an integer maximum, which vectorises).
+          using Bits = std::conditional_t<std::is_same_v<InputValueType, float>, uint32_t, uint64_t>;
+          constexpr Bits magnitudeMask = ~(Bits{ 1 } << (8 * sizeof(Bits) - 1));
+          Bits           largestBits = 0;
+          for (SizeValueType i = c * chunk; i < end; ++i)
           {
-            firstNonFinite[c] = static_cast<double>(i);
-            break;
+            Bits bits;
+            std::memcpy(&bits, in + i, sizeof(bits));
+            bits &= magnitudeMask;
+            largestBits = bits > largestBits ? bits : largestBits;
           }
-          m = std::max(m, v);
+          InputValueType largestValue;
+          std::memcpy(&largestValue, &largestBits, sizeof(largestValue));
+          m = static_cast<double>(largestValue);
+        }
+        else
+        {
+          for (SizeValueType i = c * chunk; i < end; ++i)
+          {
+            const double v = std::abs(static_cast<double>(in[i]));
+            m = v > m || v != v ? v : m;
+          }
+        }
+        if (!(m <= std::numeric_limits<double>::max()))
+        {
+          for (SizeValueType i = c * chunk; i < end; ++i)
+          {
+            if (!(std::abs(static_cast<double>(in[i])) <= std::numeric_limits<double>::max()))
+            {
+              firstNonFinite[c] = static_cast<double>(i);
+              break;
+            }
+          }
         }
         largest[c] = m;
       },
@@ -315,10 +348,19 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::Smooth(const InputImageType
       numberOfChunks,
       [&](SizeValueType c) {
         const SizeValueType end = std::min(numberOfPixels, (c + 1) * chunk);
-        for (SizeValueType i = c * chunk; i < end; ++i)
+        if (exponent == 0)
         {
-          out[i] = static_cast<float>(exponent == 0 ? static_cast<double>(in[i])
-                                                    : std::ldexp(static_cast<double>(in[i]), -exponent));
+          for (SizeValueType i = c * chunk; i < end; ++i)
+          {
+            out[i] = static_cast<float>(static_cast<double>(in[i]));
+          }
+        }
+        else
+        {
+          for (SizeValueType i = c * chunk; i < end; ++i)
+          {
+            out[i] = static_cast<float>(std::ldexp(static_cast<double>(in[i]), -exponent));
+          }
         }
       },
       nullptr);

@@ -22,7 +22,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <sstream>
+#include <type_traits>
 
 namespace itk
 {
@@ -109,6 +112,40 @@ private:
 
     const auto *        pixels = image->GetBufferPointer();
     const SizeValueType n = region.GetNumberOfPixels();
+    using ComponentType = typename ForceImageType::PixelType::ValueType;
+    constexpr unsigned int components = ForceImageType::PixelType::Dimension;
+    if constexpr (std::is_same_v<ComponentType, float> && sizeof(typename ForceImageType::PixelType) ==
+                                                            components * sizeof(float))
+    {
+      // Float vectors: squared lengths in float, their largest as the
+      // largest of their bits (non-negative floats order as their bits,
+      // infinities and NaNs above every finite value): integer maxima, a
+      // loop the compiler vectorises. Only the check's bound needs the
+      // length (float precision is plenty); a squared length that is not
+      // finite (a non-finite component, or an overflow of float) is left to
+      // the exact scan below.
+      const float * c = n > 0 ? pixels[0].GetDataPointer() : nullptr;
+      uint32_t      largestBits = 0;
+      for (SizeValueType i = 0; i < n; ++i)
+      {
+        float squared = 0.0f;
+        for (unsigned int k = 0; k < components; ++k)
+        {
+          squared += c[components * i + k] * c[components * i + k];
+        }
+        uint32_t bits;
+        std::memcpy(&bits, &squared, sizeof(bits));
+        largestBits = bits > largestBits ? bits : largestBits;
+      }
+      float largestSquared;
+      std::memcpy(&largestSquared, &largestBits, sizeof(largestSquared));
+      if (std::isfinite(largestSquared))
+      {
+        m_LargestForce = std::sqrt(static_cast<double>(largestSquared));
+        m_Diagonal = PhysicalDiagonal(image);
+        return;
+      }
+    }
     // The largest squared length, without branches: four running maxima
     // (a maximum of non-negative numbers does not depend on their order) of
     // squared lengths whose NaN or infinity, from a non-finite component,

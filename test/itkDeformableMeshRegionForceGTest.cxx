@@ -28,7 +28,9 @@
 #include "gtest/gtest.h"
 
 #include <cmath>
+#include <algorithm>
 #include <cstdint>
+#include <random>
 #include <vector>
 
 namespace
@@ -142,6 +144,60 @@ TEST(DeformableMeshRegionForce, EstimateFromRobustStatistics)
   EXPECT_DOUBLE_EQ(model.GetUpper(), 1.5);
   EXPECT_DOUBLE_EQ(model.GetWidth(), 0.0625);
   EXPECT_FALSE(model.Estimate({}, 2.5, 0.0, 1.0));
+}
+
+TEST(DeformableMeshRegionForce, SelectRankIsTheValueOfThatRank)
+{
+  // SelectRank against std::nth_element: random values, plateaus (a binary
+  // image's few distinct values), sorted and reversed arrays, sizes around
+  // the subsample's threshold, ranks at both ends and in between; and a
+  // case whose subsample misses the rank's neighbourhood (the fallback).
+  using itk::DeformableMeshFilterDetail::SelectRank;
+  std::mt19937                          random(7);
+  std::uniform_real_distribution<float> uniform(-100.0f, 100.0f);
+  const auto reference = [](std::vector<float> v, size_t k) {
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+    return v[k];
+  };
+  for (const size_t n : { size_t{ 1 }, size_t{ 1023 }, size_t{ 1024 }, size_t{ 5000 }, size_t{ 16384 } })
+  {
+    for (int kind = 0; kind < 4; ++kind)
+    {
+      std::vector<float> values(n);
+      for (float & v : values)
+      {
+        v = kind == 1 ? (uniform(random) < 20.0f ? 200.0f : 40.0f) : uniform(random);
+      }
+      if (kind == 2)
+      {
+        std::sort(values.begin(), values.end());
+      }
+      if (kind == 3)
+      {
+        std::sort(values.rbegin(), values.rend());
+      }
+      for (const double q : { 0.0, 0.02, 0.5, 0.98, 0.99, 1.0 })
+      {
+        const auto         k = static_cast<size_t>(q * static_cast<double>(n - 1));
+        std::vector<float> copy = values;
+        EXPECT_EQ(SelectRank(copy, k), reference(values, k)) << "n " << n << " kind " << kind << " q " << q;
+      }
+    }
+  }
+  // Every sixteenth value (the subsample) 0, the others 1 to n: the bracket
+  // from the subsample holds no value of rank n / 2.
+  std::vector<double> skewed(4096);
+  for (size_t i = 0; i < skewed.size(); ++i)
+  {
+    skewed[i] = i % 16 == 8 ? 0.0 : static_cast<double>(i + 1);
+  }
+  std::vector<double> sorted = skewed;
+  std::sort(sorted.begin(), sorted.end());
+  for (const size_t k : { size_t{ 0 }, size_t{ 255 }, size_t{ 256 }, size_t{ 2048 }, size_t{ 4095 } })
+  {
+    std::vector<double> copy = skewed;
+    EXPECT_EQ(SelectRank(copy, k), sorted[k]) << "k " << k;
+  }
 }
 
 TEST(DeformableMeshRegionForce, BackgroundMovesTheBoundsHalfwayToIt)

@@ -119,7 +119,7 @@ constexpr double CoarseRegionSigmaFactor = 2.0;
  * surfaces the faster capture gained no time and lowered ch2bet's Dice
  * (0.9842 to 0.9830): surfaces keep the factors 1 and
  * CoarseRegionSigmaFactor. */
-constexpr double ContourCaptureRegionWeightFactor = 2.0;
+constexpr double ContourCaptureRegionWeightFactor = 4.0;
 constexpr double ContourCaptureRegionSigmaFactor = 1.0;
 /** The demo adds gradient vector flow to the segment defaults: the seed's
  * sphere starts 12 voxels from the ends of the ellipsoid, beyond the capture

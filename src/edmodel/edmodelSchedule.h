@@ -146,15 +146,21 @@ ForceScale(const TImage * image, const SegmentOptions & o)
 }
 
 /** Runs an ExternalForceImageFilter on image with the options' force
- * settings, under the progress's "force field" stage; throws Error. */
+ * settings, under the progress's "force field" stage; throws Error. With
+ * `smoothed` set, the image is already smoothed by the force's Gaussian
+ * (SmoothWithSampledGaussian, the filter's own smoothing): the filter does
+ * not smooth it again. */
 template <typename TForceFilter>
 typename TForceFilter::OutputImageType::Pointer
-ComputeForceField(const typename TForceFilter::InputImageType * image, const SegmentOptions & o, Progress & progress)
+ComputeForceField(const typename TForceFilter::InputImageType * image,
+                  const SegmentOptions &                        o,
+                  Progress &                                    progress,
+                  bool                                          smoothed = false)
 {
   const double sigma = ForceSigma(image, o);
   auto         force = TForceFilter::New();
   force->SetInput(image);
-  force->SetSigma(sigma);
+  force->SetSigma(smoothed ? 0.0 : sigma);
   force->SetNormalizeForces(o.normalizeForces);
   force->SetUseGradientVectorFlow(o.gradientVectorFlow);
   force->SetGradientVectorFlowRegularization(o.gradientVectorFlowRegularization);
