@@ -136,69 +136,83 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareImageTerms()
     {
       m_IntensityScale = std::ldexp(1.0, -std::ilogb(largest));
     }
-    // The intensities (scaled) into the image to smooth, with the Gaussian
-    // of ExternalForceImageFilter (itkSampledGaussianSmoothing.h); in double
-    // for the scaling: 2^133 (the scale of a denormal maximum) is no float.
-    typename IntensityImageType::Pointer smoothed = IntensityImageType::New();
-    smoothed->CopyInformation(image);
-    smoothed->SetRegions(image->GetBufferedRegion());
-    smoothed->Allocate();
-    float * out = smoothed->GetBufferPointer();
-    if (m_IntensityScale != 1.0)
+    // The image the samplers read: the intensity image itself in 3-D, the
+    // slice z = 0 of a 3-D image for a 2-D one (spacing 1 and direction
+    // identity along z: the samplers read it bilinearly at (x, y, 0)).
+    const auto                                      region = image->GetBufferedRegion();
+    typename SmoothedIntensityImageType::RegionType region3;
+    typename SmoothedIntensityImageType::PointType  origin3;
+    typename SmoothedIntensityImageType::SpacingType spacing3;
+    typename SmoothedIntensityImageType::DirectionType direction3;
+    direction3.SetIdentity();
+    for (unsigned int r = 0; r < 3; ++r)
     {
-      for (size_t i = 0; i < count; ++i)
+      region3.SetIndex(r, r < PointDimension ? region.GetIndex()[r] : 0);
+      region3.SetSize(r, r < PointDimension ? region.GetSize()[r] : 1);
+      origin3[r] = r < PointDimension ? image->GetOrigin()[r] : 0.0;
+      spacing3[r] = r < PointDimension ? image->GetSpacing()[r] : 1.0;
+      for (unsigned int c = 0; c < PointDimension && r < PointDimension; ++c)
       {
-        out[i] = static_cast<float>(static_cast<double>(buffer[i]) * m_IntensityScale);
+        direction3(r, c) = image->GetDirection()(r, c);
       }
     }
-    else
-    {
-      std::copy(buffer, buffer + count, out);
-    }
+    const auto makeTarget = [&]() {
+      auto made = SmoothedIntensityImageType::New();
+      made->SetRegions(region3);
+      made->SetOrigin(origin3);
+      made->SetSpacing(spacing3);
+      made->SetDirection(direction3);
+      made->Allocate();
+      return made;
+    };
+    // The intensities (scaled) smoothed with the Gaussian of
+    // ExternalForceImageFilter (itkSampledGaussianSmoothing.h), in the
+    // image's own dimension; in double for the scaling: 2^133 (the scale of
+    // a denormal maximum) is no float. Without smoothing they go straight
+    // into the samplers' image.
+    const auto copyScaled = [&](float * out) {
+      if (m_IntensityScale != 1.0)
+      {
+        for (size_t i = 0; i < count; ++i)
+        {
+          out[i] = static_cast<float>(static_cast<double>(buffer[i]) * m_IntensityScale);
+        }
+      }
+      else
+      {
+        std::copy(buffer, buffer + count, out);
+      }
+    };
     if (m_RegionSigma > 0.0)
     {
-      typename IntensityImageType::Pointer scratch = IntensityImageType::New();
-      scratch->CopyInformation(image);
-      scratch->SetRegions(image->GetBufferedRegion());
-      scratch->Allocate();
+      const auto makeImage = [&]() {
+        typename IntensityImageType::Pointer made = IntensityImageType::New();
+        made->CopyInformation(image);
+        made->SetRegions(region);
+        made->Allocate();
+        return made;
+      };
+      typename IntensityImageType::Pointer smoothed = makeImage();
+      typename IntensityImageType::Pointer scratch = makeImage();
+      copyScaled(smoothed->GetBufferPointer());
       MultiThreaderBase * threader = this->GetMultiThreader();
       threader->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
       SmoothWithSampledGaussian<IntensityImageType>(smoothed, scratch, m_RegionSigma, threader);
-    }
-    if constexpr (PointDimension == 3)
-    {
-      m_SmoothedIntensity = smoothed;
+      if constexpr (PointDimension == 3)
+      {
+        m_SmoothedIntensity = smoothed;
+      }
+      else
+      {
+        m_SmoothedIntensity = makeTarget();
+        std::copy(
+          smoothed->GetBufferPointer(), smoothed->GetBufferPointer() + count, m_SmoothedIntensity->GetBufferPointer());
+      }
     }
     else
     {
-      // The slice z = 0 of a 3-D image (spacing 1 and direction identity
-      // along z): the samplers read it bilinearly at the points (x, y, 0).
-      const auto                                         region = smoothed->GetBufferedRegion();
-      typename SmoothedIntensityImageType::RegionType    region3;
-      typename SmoothedIntensityImageType::PointType     origin3;
-      typename SmoothedIntensityImageType::SpacingType   spacing3;
-      typename SmoothedIntensityImageType::DirectionType direction3;
-      direction3.SetIdentity();
-      for (unsigned int r = 0; r < 3; ++r)
-      {
-        region3.SetIndex(r, r < 2 ? region.GetIndex()[r] : 0);
-        region3.SetSize(r, r < 2 ? region.GetSize()[r] : 1);
-        origin3[r] = r < 2 ? smoothed->GetOrigin()[r] : 0.0;
-        spacing3[r] = r < 2 ? smoothed->GetSpacing()[r] : 1.0;
-        for (unsigned int c = 0; c < 2 && r < 2; ++c)
-        {
-          direction3(r, c) = smoothed->GetDirection()(r, c);
-        }
-      }
-      m_SmoothedIntensity = SmoothedIntensityImageType::New();
-      m_SmoothedIntensity->SetRegions(region3);
-      m_SmoothedIntensity->SetOrigin(origin3);
-      m_SmoothedIntensity->SetSpacing(spacing3);
-      m_SmoothedIntensity->SetDirection(direction3);
-      m_SmoothedIntensity->Allocate();
-      std::copy(smoothed->GetBufferPointer(),
-                smoothed->GetBufferPointer() + region.GetNumberOfPixels(),
-                m_SmoothedIntensity->GetBufferPointer());
+      m_SmoothedIntensity = makeTarget();
+      copyScaled(m_SmoothedIntensity->GetBufferPointer());
     }
     m_SmoothedIntensitySource = image;
     m_SmoothedIntensityTime = image->GetMTime();

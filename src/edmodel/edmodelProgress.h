@@ -51,6 +51,14 @@ public:
     m_Drawn = false;
   }
 
+  /** False for a quiet progress (--quiet, the repeated runs of --repeat),
+   * which never draws: callers then need not observe what they would show. */
+  bool
+  IsEnabled() const
+  {
+    return m_Enabled;
+  }
+
   /** True when Update(fraction, ...) would draw: callers that build their
    * detail text at every iteration ask first (the text costs more than a
    * small contour's iteration). */

@@ -341,7 +341,10 @@ RunLevel(TFilter *                                       deform,
   const auto        iterationsBefore = state.iterations;
   progress.Start("deforming");
   const auto    start = std::chrono::steady_clock::now();
-  const auto    progressTag = deform->AddObserver(itk::ProgressEvent(), [&](const itk::EventObject &) {
+  // Only a progress that draws observes the filter: an observer of
+  // ProgressEvent makes the filter compute its per-vertex diagnostics at
+  // every iteration, a tenth of a small contour's computation.
+  const auto progressTag = !progress.IsEnabled() ? 0UL : deform->AddObserver(itk::ProgressEvent(), [&](const itk::EventObject &) {
     const auto   total = deform->GetNumberOfIterations();
     const auto   current = deform->GetCurrentIteration();
     const double fraction = total > 0 ? static_cast<double>(current) / total : 1.0;
@@ -364,7 +367,10 @@ RunLevel(TFilter *                                       deform,
     });
   }
   const auto removeObservers = [&]() {
-    deform->RemoveObserver(progressTag);
+    if (progress.IsEnabled())
+    {
+      deform->RemoveObserver(progressTag);
+    }
     if (snapshot)
     {
       deform->RemoveObserver(snapshotTag);
