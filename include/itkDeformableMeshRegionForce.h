@@ -25,6 +25,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -76,6 +77,7 @@ template <typename T>
 T
 SelectRank(std::vector<T> & values, size_t k)
 {
+  static_assert(std::is_floating_point_v<T>, "floating-point values");
   const size_t n = values.size();
   constexpr size_t stride = 16;
   if (n < 64 * stride)

@@ -30,6 +30,7 @@
 #include <cmath>
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -197,6 +198,20 @@ TEST(DeformableMeshRegionForce, SelectRankIsTheValueOfThatRank)
   {
     std::vector<double> copy = skewed;
     EXPECT_EQ(SelectRank(copy, k), sorted[k]) << "k " << k;
+  }
+  // Infinities at both ends (ranks among them and next to them).
+  std::vector<float> infinite(5000);
+  for (size_t i = 0; i < infinite.size(); ++i)
+  {
+    infinite[i] = i % 50 == 0 ? -std::numeric_limits<float>::infinity()
+                  : i % 50 == 1 ? std::numeric_limits<float>::infinity()
+                                : uniform(random);
+  }
+  for (const size_t k : { size_t{ 0 }, size_t{ 99 }, size_t{ 100 }, size_t{ 2500 }, size_t{ 4899 }, size_t{ 4900 },
+                          size_t{ 4999 } })
+  {
+    std::vector<float> copy = infinite;
+    EXPECT_EQ(SelectRank(copy, k), reference(infinite, k)) << "k " << k;
   }
 }
 

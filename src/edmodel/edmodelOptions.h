@@ -109,15 +109,19 @@ constexpr double FineLevelEdgeLengths = 2.0;
 /** The first level's region force sees the image smoothed this many times
  * more than the later ones. */
 constexpr double CoarseRegionSigmaFactor = 2.0;
-/** On 2-D contours the capture level's region force is twice as fast (half
- * a voxel per iteration, the force field's ScaleOverSigma) and sees the
- * image smoothed as the later levels do: on the ellipse, rotated ellipse
- * and star of bench/compare-skimage.py the capture then takes 59 to 68
- * iterations instead of 108 to 120, the image is smoothed and its
- * statistics computed once instead of twice, and the final contours are as
- * close to the true curves (mean 0.038 to 0.057 pixel either way). On 3-D
- * surfaces the faster capture gained no time and lowered ch2bet's Dice
- * (0.9842 to 0.9830): surfaces keep the factors 1 and
+/** On 2-D contours the capture level's region force is four times as fast
+ * (one voxel per iteration; the transition width grows with the weight, so
+ * that the speed near the boundary is the same) and sees the image smoothed
+ * as the later levels do. On the ellipse, rotated ellipse and star of
+ * bench/compare-skimage.py the capture then takes 33 to 40 iterations (59
+ * to 68 with the factor 2, 108 to 120 with 1; 25 with 8), the image is
+ * smoothed once for the force field and the region force, and the final
+ * contours are as close to the true curves (mean 0.038 to 0.054 pixel with
+ * the factors 2, 4 and 8). On nine axial slices of ch2bet the factor 4
+ * against 2 gave the same distances to the brain's boundary (one slice
+ * better: a leak of the factor 2), the factor 8 hit the iteration cap on
+ * one. On 3-D surfaces the faster capture (factor 2) gained no time and
+ * lowered ch2bet's Dice (0.9842 to 0.9830): surfaces keep the factors 1 and
  * CoarseRegionSigmaFactor. */
 constexpr double ContourCaptureRegionWeightFactor = 4.0;
 constexpr double ContourCaptureRegionSigmaFactor = 1.0;
