@@ -1188,6 +1188,7 @@ public:
     GroupsOfKeys(m_SharedPairs, 2, numberOfTriangles, m_SharedOffsets, m_SharedOfTriangle);
     m_SharedGaps.assign(numberOfSharedPairs, 0.0f);
     m_SharedExact.assign(numberOfSharedPairs, 0);
+    m_SharedComputed.assign(numberOfSharedPairs, 0.0f);
     m_HasSurface = true;
     this->Invalidate();
   }
@@ -1227,6 +1228,14 @@ public:
   GetTriangles() const
   {
     return m_Triangles;
+  }
+
+  /** Shared pairs whose bound the last rebuild computed (the others were
+   * carried over from the rebuild before), for diagnostics and tests. */
+  SizeValueType
+  GetNumberOfComputedSharedGaps() const
+  {
+    return m_NumberOfComputedSharedGaps;
   }
 
   /** Number of index rebuilds since SetSurface(). */
@@ -1323,6 +1332,7 @@ public:
     // The bounds at y; when one fails the index is rebuilt at y (where
     // every displacement is zero and every bound holds).
     bool bounded = false;
+    bool carry = false;
     if (m_IndexValid)
     {
       const BoundStatus status = this->Bound(y, parallel);
@@ -1331,10 +1341,13 @@ public:
         return result; // a diverged step: the filter reports it
       }
       bounded = status == BoundStatus::Bounded;
+      // Every triangle's box of y - r is set: the shared pairs' bounds at r
+      // carry over to y.
+      carry = true;
     }
     if (!bounded)
     {
-      if (!this->Build(y, minimumDistance, parallel))
+      if (!this->Build(y, minimumDistance, parallel, carry))
       {
         return result; // a diverged step: the filter reports it
       }
@@ -1747,6 +1760,16 @@ private:
    * (beyond the minimum distance). */
   static constexpr double RadiusFactor = 0.75;
 
+  /** The shared pairs' bounds are computed up to this many R at a rebuild
+   * (the separating axes tried until the bound reaches it), so that the
+   * next rebuilds can carry them over (CarriedSharedGap()) while they stay
+   * at least R. */
+  static constexpr double SharedSlack = 1.25;
+
+  /** A shared pair's bound is carried over while it has lost at most this
+   * many R since it was computed. */
+  static constexpr double SharedLoss = 0.25;
+
   enum class BoundStatus
   {
     Bounded,
@@ -2065,6 +2088,21 @@ private:
     return std::max(0.0, std::min(first, second) - margin);
   }
 
+  /** The bound of shared pair q's gap at new reference positions r', from
+   * its bound g at the reference r and every triangle's box of r' - r
+   * (m_TriangleDelta): a point of one triangle and a point of the other
+   * come closer by at most the largest distance between their boxes, so
+   * the gap at r' is at least g less that distance (rounded down; 0 at
+   * least). */
+  float
+  CarriedSharedGap(SizeValueType q) const
+  {
+    const double motion = LargestDistance(m_TriangleDelta.data() + 6 * m_SharedPairs[2 * q],
+                                          m_TriangleDelta.data() + 6 * m_SharedPairs[2 * q + 1]);
+    const double g = static_cast<double>(m_SharedGaps[q]) - motion;
+    return g > 0.0 ? RoundDown(g * (1.0 - 1e-12)) : 0.0f;
+  }
+
   /** Shared pair q cannot violate while the relative motion of its
    * triangles is below \a motion: its gap at the reference less the
    * contact distance is above the motion (with the exact gap computed once
@@ -2150,10 +2188,13 @@ private:
 
   /** Rebuilds the index at the reference positions x (see the class
    * documentation), with the candidate radius d + RadiusFactor mean edge
-   * lengths. False (and nothing built) when a coordinate is not finite. */
+   * lengths. With \a carry, m_TriangleDelta holds every triangle's box of
+   * x - r (r the former reference, Bound() at x): the shared pairs' bounds
+   * are carried over (CarriedSharedGap()). False (and nothing built) when a
+   * coordinate is not finite. */
   template <typename TParallel>
   bool
-  Build(const double * x, double minimumDistance, TParallel && parallel)
+  Build(const double * x, double minimumDistance, TParallel && parallel, bool carry = false)
   {
     const SizeValueType n = m_NumberOfPoints;
     const SizeValueType numberOfTriangles = this->GetNumberOfTriangles();
@@ -2385,7 +2426,8 @@ private:
     const SizeValueType            cellBlocks = (baseCells + 1023) / 1024;
     std::vector<std::vector<Pair>> pairs(cellBlocks + 1);
     parallel(baseCells, [&](SizeValueType begin, SizeValueType end) {
-      auto & out = pairs[begin / 1024];
+      auto &                 out = pairs[begin / 1024];
+      std::vector<IndexType> hits;
       for (SizeValueType s = begin; s < end; ++s)
       {
         for (IndexType c = base.neighbourOffsets[s]; c < base.neighbourOffsets[s + 1]; ++c)
@@ -2395,20 +2437,33 @@ private:
           {
             continue;
           }
+          const IndexType last = m_CellOffsets[other + 1];
           for (IndexType i = m_CellOffsets[s]; i < m_CellOffsets[s + 1]; ++i)
           {
-            const double * si = cellSpheres.data() + 4 * i;
-            for (IndexType j = other == s ? i + 1 : m_CellOffsets[other]; j < m_CellOffsets[other + 1]; ++j)
+            const double *  si = cellSpheres.data() + 4 * i;
+            const double    reachOfI = radius + si[3];
+            const IndexType first = other == s ? i + 1 : m_CellOffsets[other];
+            // The pairs whose spheres come within R, listed without a branch
+            // (about one in seven passes: the branch was mispredicted).
+            hits.resize(std::max<SizeValueType>(hits.size(), last - std::min(first, last)));
+            SizeValueType count = 0;
+            for (IndexType j = first; j < last; ++j)
             {
               const double * sj = cellSpheres.data() + 4 * j;
               const double   e0 = si[0] - sj[0];
               const double   e1 = si[1] - sj[1];
               const double   e2 = si[2] - sj[2];
-              const double   reach = radius + si[3] + sj[3];
-              // Spheres apart by more than R, or a shared vertex (half of
-              // the pairs whose spheres come within R): no candidate.
-              if (e0 * e0 + e1 * e1 + e2 * e2 >= reach * reach * (1.0 + 1e-12) ||
-                  SurfaceCollisionDetail::ShareVertex(cellTriangles.data() + 3 * i, cellTriangles.data() + 3 * j))
+              const double   reach = reachOfI + sj[3];
+              hits[count] = j;
+              count += e0 * e0 + e1 * e1 + e2 * e2 < reach * reach * (1.0 + 1e-12) ? 1 : 0;
+            }
+            for (SizeValueType h = 0; h < count; ++h)
+            {
+              const IndexType j = hits[h];
+              const double *  sj = cellSpheres.data() + 4 * j;
+              // A shared vertex (half of the pairs whose spheres come
+              // within R): no candidate.
+              if (SurfaceCollisionDetail::ShareVertex(cellTriangles.data() + 3 * i, cellTriangles.data() + 3 * j))
               {
                 continue;
               }
@@ -2506,14 +2561,33 @@ private:
     });
     // The pairs sharing one vertex: their gaps at the reference (exact), and
     // the clearance of their triangles against the contact distance.
+    // A bound carried over from the former reference while it has lost at
+    // most SharedLoss R since it was computed (a lower bound lowers the
+    // clearances, so that more triangles are tested, but never misses a
+    // pair); otherwise computed, to SharedSlack R so that the next rebuilds
+    // can carry it.
+    std::atomic<SizeValueType> computed{ 0 };
     parallel(m_SharedGaps.size(), [&](SizeValueType begin, SizeValueType end) {
+      SizeValueType count = 0;
       for (SizeValueType q = begin; q < end; ++q)
       {
         m_SharedExact[q] = 0;
-        // Beyond R the bound does not lower any clearance (at most R - d).
-        m_SharedGaps[q] = RoundDown(this->SharedGapLowerBound(q, x, radius));
+        if (carry)
+        {
+          const float carried = this->CarriedSharedGap(q);
+          if (static_cast<double>(carried) >= static_cast<double>(m_SharedComputed[q]) - SharedLoss * radius)
+          {
+            m_SharedGaps[q] = carried;
+            continue;
+          }
+        }
+        ++count;
+        m_SharedGaps[q] = RoundDown(this->SharedGapLowerBound(q, x, SharedSlack * radius));
+        m_SharedComputed[q] = m_SharedGaps[q];
       }
+      computed += count;
     });
+    m_NumberOfComputedSharedGaps = computed;
     parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
       for (SizeValueType t = begin; t < end; ++t)
       {
@@ -2829,6 +2903,7 @@ private:
   std::vector<IndexType>     m_SharedOfTriangle; // the shared pairs each triangle is in
   std::vector<float>         m_SharedGaps;       // per shared pair: a lower bound of its gap at the reference
   std::vector<uint8_t>       m_SharedExact;      // per shared pair: the bound is the exact gap
+  std::vector<float>         m_SharedComputed;   // per shared pair: its bound when last computed (not carried)
 
   // The index (see the class documentation).
   bool                            m_IndexValid{ false };
@@ -2836,6 +2911,7 @@ private:
   double                          m_ContactDistance{ 0.0 };
   double                          m_Radius{ 0.0 };
   SizeValueType                   m_NumberOfRebuilds{ 0 };
+  SizeValueType                   m_NumberOfComputedSharedGaps{ 0 };
   std::vector<double>             m_Reference;
   std::vector<double>             m_Spheres; // per triangle at the reference: centre, radius
   std::vector<IndexType>          m_CandidateOffsets;
