@@ -1436,6 +1436,14 @@ public:
       // closer than d + the largest distance between t's displacement box
       // and the box of all displacements at the reference.
       m_NumberOfTestedTriangles += m_Large.size();
+      for (const IndexType t : m_Large)
+      {
+        if (!(LargestDistance(m_TriangleDelta.data() + 6 * t, m_GlobalDelta) < m_Radius - d))
+        {
+          this->EnsureReferenceGrid(); // before the parallel pass that queries it
+          break;
+        }
+      }
       const SizeValueType                                       largeBlocks = (m_Large.size() + 1023) / 1024;
       std::vector<std::vector<std::pair<IndexType, IndexType>>> largeFound(largeBlocks);
       parallel(m_Large.size(), [&](SizeValueType begin, SizeValueType end) {
@@ -1941,6 +1949,7 @@ private:
     TriangleBox(m_Reference.data(), m_Triangles.data() + 3 * t, lo, hi);
     float query[6];
     SurfaceCollisionDetail::StoreBox(lo, hi, reach, query);
+    this->EnsureReferenceGrid();
     m_ReferenceGrid.ForEachOverlapOfBox(query, t, [&](SizeValueType u) {
       if ((!m_IsLarge[t] && !m_IsLarge[u]) ||
           SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
@@ -1949,6 +1958,18 @@ private:
       }
       f(u);
     });
+  }
+
+  /** Builds the grid of every triangle's box at the reference (widened by
+   * R/2) if this index has not built it yet. */
+  void
+  EnsureReferenceGrid()
+  {
+    if (!m_ReferenceGridBuilt)
+    {
+      m_ReferenceGrid.Build(m_ReferenceBoxes.data(), this->GetNumberOfTriangles());
+      m_ReferenceGridBuilt = true;
+    }
   }
 
   /** Candidate c of triangle t may violate when the relative motion of the
@@ -2481,13 +2502,13 @@ private:
         }
       }
     });
-    if (m_Large.empty())
+    // The grid of every triangle's box is built only when a step needs it
+    // (EnsureReferenceGrid()): building it at every rebuild for a few large
+    // triangles was a tenth of the rebuild.
+    m_ReferenceGrid.Clear();
+    m_ReferenceGridBuilt = false;
+    if (!m_Large.empty())
     {
-      m_ReferenceGrid.Clear();
-    }
-    else
-    {
-      m_ReferenceGrid.Build(boxes.data(), numberOfTriangles);
       auto &     out = pairs[cellBlocks];
       const auto corners = [x](const IndexType * v, double * c) {
         for (unsigned int k = 0; k < 3; ++k)
@@ -2495,19 +2516,32 @@ private:
           std::copy_n(x + 3 * v[k], 3, c + 3 * k);
         }
       };
-      for (const IndexType t : m_Large)
+      // The large triangles' boxes, for a grid of their own (their pairs).
+      std::vector<float> largeBoxes(6 * m_Large.size());
+      for (SizeValueType l = 0; l < m_Large.size(); ++l)
       {
+        std::copy_n(boxes.data() + 6 * m_Large[l], 6, largeBoxes.data() + 6 * l);
+      }
+      SurfaceCollisionDetail::BoxGrid largeGrid;
+      largeGrid.Build(largeBoxes.data(), m_Large.size());
+      const double limit = static_cast<double>((uint64_t{ 1 } << KeyBits) - 1);
+      const auto   keyOf = [&](double c, unsigned int k) {
+        return std::min(limit, std::max(0.0, std::floor((c - lower[k]) / cellSize) + 1.0));
+      };
+      for (SizeValueType l = 0; l < m_Large.size(); ++l)
+      {
+        const IndexType   t = m_Large[l];
         const IndexType * vt = m_Triangles.data() + 3 * t;
         const double *    st = m_Spheres.data() + 4 * t;
         double            a[9];
         corners(vt, a);
-        m_ReferenceGrid.ForEachOverlapOfBox(boxes.data() + 6 * t, t, [&](SizeValueType u) {
+        const auto test = [&](IndexType u) {
           const IndexType * vu = m_Triangles.data() + 3 * u;
           const double *    su = m_Spheres.data() + 4 * u;
           double            e[3];
           SurfaceCollisionDetail::Subtract(su, st, e);
           const double reach = radius + st[3] + su[3];
-          if ((m_IsLarge[u] && u < t) || SurfaceCollisionDetail::ShareVertex(vt, vu) ||
+          if (SurfaceCollisionDetail::ShareVertex(vt, vu) ||
               SurfaceCollisionDetail::Dot(e, e) >= reach * reach * (1.0 + 1e-12))
           {
             return;
@@ -2515,6 +2549,41 @@ private:
           double b[9];
           corners(vu, b);
           consider(t, u, st, su, boxes.data() + 6 * t, boxes.data() + 6 * u, a, b, out);
+        };
+        // The triangles of the cells: their centroids are within
+        // R + r_t + (the cells' largest radius) of t's along each axis when
+        // their spheres come within R.
+        const double reach = (radius + st[3] + typicalRadius) * (1.0 + 1e-9);
+        uint64_t     lo[3], hi[3];
+        for (unsigned int k = 0; k < 3; ++k)
+        {
+          lo[k] = static_cast<uint64_t>(keyOf(st[k] - reach, k));
+          hi[k] = static_cast<uint64_t>(keyOf(st[k] + reach, k));
+        }
+        for (uint64_t i = lo[0]; i <= hi[0]; ++i)
+        {
+          for (uint64_t j = lo[1]; j <= hi[1]; ++j)
+          {
+            const uint64_t first = Key(i, j, lo[2]);
+            const uint64_t last = Key(i, j, hi[2]);
+            for (auto c = std::lower_bound(base.keys.begin(), base.keys.end(), first);
+                 c != base.keys.end() && *c <= last;
+                 ++c)
+            {
+              const auto cell = static_cast<SizeValueType>(c - base.keys.begin());
+              for (IndexType o = m_CellOffsets[cell]; o < m_CellOffsets[cell + 1]; ++o)
+              {
+                test(m_CellOrder[o]);
+              }
+            }
+          }
+        }
+        // The other large triangles (each pair once).
+        largeGrid.ForEachOverlapOfBox(largeBoxes.data() + 6 * l, l, [&](SizeValueType other) {
+          if (other > l)
+          {
+            test(m_Large[other]);
+          }
         });
       }
     }
@@ -2926,7 +2995,8 @@ private:
   std::vector<IndexType>          m_Large;          // triangles larger than the cells are made for
   std::vector<uint8_t>            m_IsLarge;        // per triangle
   std::vector<float>              m_ReferenceBoxes; // per triangle at the reference, widened by R/2
-  SurfaceCollisionDetail::BoxGrid m_ReferenceGrid;
+  SurfaceCollisionDetail::BoxGrid m_ReferenceGrid;  // built when a step needs it (EnsureReferenceGrid())
+  bool                            m_ReferenceGridBuilt{ false };
   std::vector<float>              m_CellClearance;
 
   // Per step.

@@ -833,6 +833,49 @@ TEST(SurfaceCollision, RandomStepsWithLargeTrianglesNeverBringPairsCloserThanD)
   EXPECT_EQ(stats.largeTriangles, 2u) << "the two corner triangles";
 }
 
+TEST(SurfaceCollision, ALargeTriangleStopsAtDBelowSmallOnes)
+{
+  // Two sheets 0.3 apart (d = 0.1), the lower one's corner point 12 pulled
+  // out by (1.5, -1.5) (one large triangle, in no cell) and the upper one
+  // moved by (1.6, -1.6) so that its small triangles cover the large one.
+  // Only the pulled-out corner rises, by 0.05 a step: the pairs of the
+  // large triangle with the small ones above it are found only by the
+  // large triangles' candidate search (the cells of the small triangles
+  // around it, at each rebuild), and only those candidates are tested while
+  // its motion stays below R - d. Unconstrained, the corner would pass the
+  // upper sheet.
+  std::vector<double>   x;
+  std::vector<uint32_t> triangles;
+  TwoSheets(0.3, x, triangles);
+  const std::size_t n = x.size() / 3;
+  x[3 * 12] += 1.5;
+  x[3 * 12 + 1] -= 1.5;
+  for (std::size_t i = n / 2; i < n; ++i)
+  {
+    x[3 * i] += 1.6;
+    x[3 * i + 1] -= 1.6;
+  }
+  const double d = 0.1;
+  ASSERT_GE(CheckAllPairs(x, triangles, d).smallestDistance, d);
+  itk::SurfaceCollision collision;
+  collision.SetSurface(n, triangles.data(), triangles.size() / 3);
+  double unconstrained = std::numeric_limits<double>::infinity();
+  for (unsigned int step = 0; step < 10; ++step)
+  {
+    std::vector<double> y = x;
+    y[3 * 12 + 2] += 0.05;
+    unconstrained = std::min(unconstrained, CheckAllPairs(y, triangles, d).smallestDistance);
+    collision.Constrain(x.data(), y.data(), d, nullptr, 1);
+    EXPECT_EQ(collision.GetNumberOfLargeTriangles(), 1u);
+    const BruteForce check = CheckAllPairs(y, triangles, d);
+    ASSERT_EQ(check.intersecting, 0u) << "step " << step;
+    ASSERT_GE(check.smallestDistance, d - 1e-9) << "step " << step;
+    x = y;
+  }
+  EXPECT_LT(unconstrained, d) << "the proposed steps would have come within d";
+  EXPECT_LT(x[3 * 12 + 2], 0.3) << "the corner stopped below the upper sheet";
+}
+
 TEST(SurfaceCollision, ALargeTriangleMovingAloneStopsAtD)
 {
   // Two sheets 0.3 apart (d = 0.1) with the same corner of each pulled out
