@@ -587,6 +587,52 @@ BM_EDM_Remeshing(benchmark::State & state)
   state.SetLabel("remeshing every 10 iterations, steps/update=20");
 }
 
+// Issue 15's combined speed target: remeshing every 10 iterations (as in
+// BM_EDM_Remeshing) together with the collision test (PreventSelfIntersections)
+// at every iteration, 2 threads, 20 steps per update. Each remeshing that
+// changes the topology gives the collision test a new surface, whose index
+// is rebuilt at the next step.
+void
+BM_EDM_CollisionsAndRemeshing(benchmark::State & state)
+{
+  const int64_t      requested = state.range(0);
+  constexpr unsigned threads = 2;
+  ThreadScope        scope(threads);
+  const MeshType *   input = ModelMesh(requested);
+  constexpr unsigned steps = 20;
+
+  auto model = ModelType::New();
+  model->SetInput(input);
+  model->SetForceImage(MeshForceImage());
+  model->SetScaleFactor(0.5);
+  model->SetElasticity(0.3);
+  model->SetRigidity(0.1);
+  model->SetRemeshingEdgeLength(MeanEdgeLength(input));
+  model->SetRemeshingInterval(10);
+  model->SetPreventSelfIntersections(true);
+  model->SetIterateFromZero(false);
+  model->SetNumberOfWorkUnits(4 * threads);
+  model->SetNumberOfIterations(1);
+  model->Update();
+
+  int64_t      vertexIterations = 0;
+  const double cpuStart = ProcessCPUSeconds();
+  for (auto _ : state)
+  {
+    const auto vertices = static_cast<int64_t>(model->GetOutput()->GetNumberOfPoints());
+    model->SetNumberOfIterations(model->GetCurrentIteration() + steps);
+    model->Update();
+    vertexIterations += steps * (vertices + static_cast<int64_t>(model->GetOutput()->GetNumberOfPoints())) / 2;
+  }
+  SetCPUTimeCounter(state, ProcessCPUSeconds() - cpuStart, static_cast<double>(vertexIterations));
+  state.counters["vertices"] = static_cast<double>(model->GetOutput()->GetNumberOfPoints());
+  state.counters["remeshings"] = static_cast<double>(model->GetNumberOfRemeshings());
+  state.counters["collisions"] = static_cast<double>(model->GetTotalNumberOfCollisionsPrevented());
+  state.counters["vertex_it/s"] =
+    benchmark::Counter(static_cast<double>(vertexIterations), benchmark::Counter::kIsRate);
+  state.SetLabel("remeshing every 10 iterations, collision test every iteration, steps/update=20");
+}
+
 // Issue 15 item 5: the plain step on itk::RegularSphereMeshSource's sphere of
 // 262 146 points (resolution 8), whose subdivisions number new points far
 // from their neighbours; Elasticity 0.1, Rigidity 0.05, 2 threads; with the
@@ -1009,6 +1055,13 @@ BENCHMARK(BM_EDM_Remeshing)
   ->UseRealTime()
   ->Unit(benchmark::kMillisecond)
   ->ComputeStatistics("max", Largest);
+BENCHMARK(BM_EDM_CollisionsAndRemeshing)
+  ->Arg(100000)
+  ->Arg(1000000)
+  ->ArgName("vertices")
+  ->UseRealTime()
+  ->Unit(benchmark::kMillisecond)
+  ->ComputeStatistics("max", Largest);
 BENCHMARK(BM_EDM_RegularSphereSource)
   ->Arg(1)
   ->Arg(0)
@@ -1180,6 +1233,18 @@ PrintSummary()
                   collision1M * 1e-6,
                   CPUTime("BM_EDM_SelfIntersection/vertices:100000/threads:2/real_time"),
                   CPUTime("BM_EDM_SelfIntersection/vertices:1000000/threads:2/real_time"));
+    }
+    const double combined100k = Rate("BM_EDM_CollisionsAndRemeshing/vertices:100000/real_time");
+    const double combined1M = Rate("BM_EDM_CollisionsAndRemeshing/vertices:1000000/real_time");
+    if (combined100k + combined1M > 0.0)
+    {
+      std::printf("remeshing every 10 iterations with the collision test every iteration, 2 threads: 100000 vertices "
+                  "%.2f M, 1000000 vertices %.2f M vertex-iterations/s (issue 15 target: 25 M); CPU time per "
+                  "vertex-iteration %.0f ns and %.0f ns\n",
+                  combined100k * 1e-6,
+                  combined1M * 1e-6,
+                  CPUTime("BM_EDM_CollisionsAndRemeshing/vertices:100000/real_time"),
+                  CPUTime("BM_EDM_CollisionsAndRemeshing/vertices:1000000/real_time"));
     }
     if (renumbered + asInput > 0.0)
     {

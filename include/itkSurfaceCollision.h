@@ -1188,6 +1188,7 @@ public:
     GroupsOfKeys(m_SharedPairs, 2, numberOfTriangles, m_SharedOffsets, m_SharedOfTriangle);
     m_SharedGaps.assign(numberOfSharedPairs, 0.0f);
     m_SharedExact.assign(numberOfSharedPairs, 0);
+    m_SharedComputed.assign(numberOfSharedPairs, 0.0f);
     m_HasSurface = true;
     this->Invalidate();
   }
@@ -1227,6 +1228,14 @@ public:
   GetTriangles() const
   {
     return m_Triangles;
+  }
+
+  /** Shared pairs whose bound the last rebuild computed (the others were
+   * carried over from the rebuild before), for diagnostics and tests. */
+  SizeValueType
+  GetNumberOfComputedSharedGaps() const
+  {
+    return m_NumberOfComputedSharedGaps;
   }
 
   /** Number of index rebuilds since SetSurface(). */
@@ -1323,6 +1332,7 @@ public:
     // The bounds at y; when one fails the index is rebuilt at y (where
     // every displacement is zero and every bound holds).
     bool bounded = false;
+    bool carry = false;
     if (m_IndexValid)
     {
       const BoundStatus status = this->Bound(y, parallel);
@@ -1331,10 +1341,13 @@ public:
         return result; // a diverged step: the filter reports it
       }
       bounded = status == BoundStatus::Bounded;
+      // Every triangle's box of y - r is set: the shared pairs' bounds at r
+      // carry over to y.
+      carry = true;
     }
     if (!bounded)
     {
-      if (!this->Build(y, minimumDistance, parallel))
+      if (!this->Build(y, minimumDistance, parallel, carry))
       {
         return result; // a diverged step: the filter reports it
       }
@@ -1423,6 +1436,14 @@ public:
       // closer than d + the largest distance between t's displacement box
       // and the box of all displacements at the reference.
       m_NumberOfTestedTriangles += m_Large.size();
+      for (const IndexType t : m_Large)
+      {
+        if (!(LargestDistance(m_TriangleDelta.data() + 6 * t, m_GlobalDelta) < m_Radius - d))
+        {
+          this->EnsureReferenceGrid(); // before the parallel pass that queries it
+          break;
+        }
+      }
       const SizeValueType                                       largeBlocks = (m_Large.size() + 1023) / 1024;
       std::vector<std::vector<std::pair<IndexType, IndexType>>> largeFound(largeBlocks);
       parallel(m_Large.size(), [&](SizeValueType begin, SizeValueType end) {
@@ -1747,6 +1768,16 @@ private:
    * (beyond the minimum distance). */
   static constexpr double RadiusFactor = 0.75;
 
+  /** The shared pairs' bounds are computed up to this many R at a rebuild
+   * (the separating axes tried until the bound reaches it), so that the
+   * next rebuilds can carry them over (CarriedSharedGap()) while they stay
+   * at least R. */
+  static constexpr double SharedSlack = 1.25;
+
+  /** A shared pair's bound is carried over while it has lost at most this
+   * many R since it was computed. */
+  static constexpr double SharedLoss = 0.25;
+
   enum class BoundStatus
   {
     Bounded,
@@ -1777,6 +1808,37 @@ private:
   Key(uint64_t i, uint64_t j, uint64_t k)
   {
     return (i << (2 * KeyBits)) | (j << KeyBits) | k;
+  }
+
+  /** Sorts \a pairs by their keys (below 2^keyBits), stably: a least
+   * significant digit radix sort. */
+  static void
+  RadixSortByKey(std::vector<std::pair<uint64_t, IndexType>> & pairs, unsigned int keyBits)
+  {
+    constexpr unsigned int                      digitBits = 11;
+    constexpr SizeValueType                     digits = SizeValueType{ 1 } << digitBits;
+    std::vector<std::pair<uint64_t, IndexType>> other(pairs.size());
+    std::vector<SizeValueType>                  counts(digits);
+    for (unsigned int shift = 0; shift < keyBits; shift += digitBits)
+    {
+      std::fill(counts.begin(), counts.end(), 0);
+      for (const auto & p : pairs)
+      {
+        ++counts[(p.first >> shift) & (digits - 1)];
+      }
+      SizeValueType sum = 0;
+      for (auto & c : counts)
+      {
+        const SizeValueType here = c;
+        c = sum;
+        sum += here;
+      }
+      for (const auto & p : pairs)
+      {
+        other[counts[(p.first >> shift) & (digits - 1)]++] = p;
+      }
+      pairs.swap(other);
+    }
   }
 
   /** The occupied cells among the 27 around each cell of \a level (itself
@@ -1918,6 +1980,7 @@ private:
     TriangleBox(m_Reference.data(), m_Triangles.data() + 3 * t, lo, hi);
     float query[6];
     SurfaceCollisionDetail::StoreBox(lo, hi, reach, query);
+    this->EnsureReferenceGrid();
     m_ReferenceGrid.ForEachOverlapOfBox(query, t, [&](SizeValueType u) {
       if ((!m_IsLarge[t] && !m_IsLarge[u]) ||
           SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
@@ -1926,6 +1989,18 @@ private:
       }
       f(u);
     });
+  }
+
+  /** Builds the grid of every triangle's box at the reference (widened by
+   * R/2) if this index has not built it yet. */
+  void
+  EnsureReferenceGrid()
+  {
+    if (!m_ReferenceGridBuilt)
+    {
+      m_ReferenceGrid.Build(m_ReferenceBoxes.data(), this->GetNumberOfTriangles());
+      m_ReferenceGridBuilt = true;
+    }
   }
 
   /** Candidate c of triangle t may violate when the relative motion of the
@@ -2065,6 +2140,21 @@ private:
     return std::max(0.0, std::min(first, second) - margin);
   }
 
+  /** The bound of shared pair q's gap at new reference positions r', from
+   * its bound g at the reference r and every triangle's box of r' - r
+   * (m_TriangleDelta): a point of one triangle and a point of the other
+   * come closer by at most the largest distance between their boxes, so
+   * the gap at r' is at least g less that distance (rounded down; 0 at
+   * least). */
+  float
+  CarriedSharedGap(SizeValueType q) const
+  {
+    const double motion = LargestDistance(m_TriangleDelta.data() + 6 * m_SharedPairs[2 * q],
+                                          m_TriangleDelta.data() + 6 * m_SharedPairs[2 * q + 1]);
+    const double g = static_cast<double>(m_SharedGaps[q]) - motion;
+    return g > 0.0 ? RoundDown(g * (1.0 - 1e-12)) : 0.0f;
+  }
+
   /** Shared pair q cannot violate while the relative motion of its
    * triangles is below \a motion: its gap at the reference less the
    * contact distance is above the motion (with the exact gap computed once
@@ -2150,10 +2240,13 @@ private:
 
   /** Rebuilds the index at the reference positions x (see the class
    * documentation), with the candidate radius d + RadiusFactor mean edge
-   * lengths. False (and nothing built) when a coordinate is not finite. */
+   * lengths. With \a carry, m_TriangleDelta holds every triangle's box of
+   * x - r (r the former reference, Bound() at x): the shared pairs' bounds
+   * are carried over (CarriedSharedGap()). False (and nothing built) when a
+   * coordinate is not finite. */
   template <typename TParallel>
   bool
-  Build(const double * x, double minimumDistance, TParallel && parallel)
+  Build(const double * x, double minimumDistance, TParallel && parallel, bool carry = false)
   {
     const SizeValueType n = m_NumberOfPoints;
     const SizeValueType numberOfTriangles = this->GetNumberOfTriangles();
@@ -2266,8 +2359,19 @@ private:
     {
       cellSize = 1.0; // a degenerate surface (every point at one place)
     }
-    // The triangles sorted by the key of their cell (pairs of key and
-    // triangle, sorted as such: no indirection in the comparisons).
+    // The triangles sorted by the key of their cell, then by index: a
+    // radix sort of (key, triangle) pairs in triangle order on keys packed to
+    // the bits the cell coordinates need (std::sort was a tenth of a rebuild).
+    unsigned int bits[3];
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      const auto largest = static_cast<uint64_t>((upper[k] - lower[k]) / cellSize) + 1;
+      bits[k] = 1;
+      while (bits[k] < KeyBits && (largest >> bits[k]) != 0)
+      {
+        ++bits[k];
+      }
+    }
     std::vector<std::pair<uint64_t, IndexType>> order;
     order.reserve(numberOfTriangles - m_Large.size());
     for (SizeValueType t = 0; t < numberOfTriangles; ++t)
@@ -2281,9 +2385,16 @@ private:
       {
         c[k] = static_cast<uint64_t>((m_Spheres[4 * t + k] - lower[k]) / cellSize) + 1;
       }
-      order.emplace_back(Key(c[0], c[1], c[2]), static_cast<IndexType>(t));
+      order.emplace_back((c[0] << (bits[1] + bits[2])) | (c[1] << bits[2]) | c[2], static_cast<IndexType>(t));
     }
-    std::sort(order.begin(), order.end());
+    RadixSortByKey(order, bits[0] + bits[1] + bits[2]);
+    for (auto & entry : order)
+    {
+      const uint64_t packed = entry.first;
+      entry.first = Key(packed >> (bits[1] + bits[2]),
+                        (packed >> bits[2]) & ((uint64_t{ 1 } << bits[1]) - 1),
+                        packed & ((uint64_t{ 1 } << bits[2]) - 1));
+    }
     m_Levels.clear();
     m_Levels.emplace_back();
     m_Levels[0].cellSize = cellSize;
@@ -2385,7 +2496,8 @@ private:
     const SizeValueType            cellBlocks = (baseCells + 1023) / 1024;
     std::vector<std::vector<Pair>> pairs(cellBlocks + 1);
     parallel(baseCells, [&](SizeValueType begin, SizeValueType end) {
-      auto & out = pairs[begin / 1024];
+      auto &                 out = pairs[begin / 1024];
+      std::vector<IndexType> hits;
       for (SizeValueType s = begin; s < end; ++s)
       {
         for (IndexType c = base.neighbourOffsets[s]; c < base.neighbourOffsets[s + 1]; ++c)
@@ -2395,20 +2507,33 @@ private:
           {
             continue;
           }
+          const IndexType last = m_CellOffsets[other + 1];
           for (IndexType i = m_CellOffsets[s]; i < m_CellOffsets[s + 1]; ++i)
           {
-            const double * si = cellSpheres.data() + 4 * i;
-            for (IndexType j = other == s ? i + 1 : m_CellOffsets[other]; j < m_CellOffsets[other + 1]; ++j)
+            const double *  si = cellSpheres.data() + 4 * i;
+            const double    reachOfI = radius + si[3];
+            const IndexType first = other == s ? i + 1 : m_CellOffsets[other];
+            // The pairs whose spheres come within R, listed without a branch
+            // (about one in seven passes: the branch was mispredicted).
+            hits.resize(std::max<SizeValueType>(hits.size(), last - std::min(first, last)));
+            SizeValueType count = 0;
+            for (IndexType j = first; j < last; ++j)
             {
               const double * sj = cellSpheres.data() + 4 * j;
               const double   e0 = si[0] - sj[0];
               const double   e1 = si[1] - sj[1];
               const double   e2 = si[2] - sj[2];
-              const double   reach = radius + si[3] + sj[3];
-              // Spheres apart by more than R, or a shared vertex (half of
-              // the pairs whose spheres come within R): no candidate.
-              if (e0 * e0 + e1 * e1 + e2 * e2 >= reach * reach * (1.0 + 1e-12) ||
-                  SurfaceCollisionDetail::ShareVertex(cellTriangles.data() + 3 * i, cellTriangles.data() + 3 * j))
+              const double   reach = reachOfI + sj[3];
+              hits[count] = j;
+              count += e0 * e0 + e1 * e1 + e2 * e2 < reach * reach * (1.0 + 1e-12) ? 1 : 0;
+            }
+            for (SizeValueType h = 0; h < count; ++h)
+            {
+              const IndexType j = hits[h];
+              const double *  sj = cellSpheres.data() + 4 * j;
+              // A shared vertex (half of the pairs whose spheres come
+              // within R): no candidate.
+              if (SurfaceCollisionDetail::ShareVertex(cellTriangles.data() + 3 * i, cellTriangles.data() + 3 * j))
               {
                 continue;
               }
@@ -2426,13 +2551,13 @@ private:
         }
       }
     });
-    if (m_Large.empty())
+    // The grid of every triangle's box is built only when a step needs it
+    // (EnsureReferenceGrid()): building it at every rebuild for a few large
+    // triangles was a tenth of the rebuild.
+    m_ReferenceGrid.Clear();
+    m_ReferenceGridBuilt = false;
+    if (!m_Large.empty())
     {
-      m_ReferenceGrid.Clear();
-    }
-    else
-    {
-      m_ReferenceGrid.Build(boxes.data(), numberOfTriangles);
       auto &     out = pairs[cellBlocks];
       const auto corners = [x](const IndexType * v, double * c) {
         for (unsigned int k = 0; k < 3; ++k)
@@ -2440,19 +2565,32 @@ private:
           std::copy_n(x + 3 * v[k], 3, c + 3 * k);
         }
       };
-      for (const IndexType t : m_Large)
+      // The large triangles' boxes, for a grid of their own (their pairs).
+      std::vector<float> largeBoxes(6 * m_Large.size());
+      for (SizeValueType l = 0; l < m_Large.size(); ++l)
       {
+        std::copy_n(boxes.data() + 6 * m_Large[l], 6, largeBoxes.data() + 6 * l);
+      }
+      SurfaceCollisionDetail::BoxGrid largeGrid;
+      largeGrid.Build(largeBoxes.data(), m_Large.size());
+      const double limit = static_cast<double>((uint64_t{ 1 } << KeyBits) - 1);
+      const auto   keyOf = [&](double c, unsigned int k) {
+        return std::min(limit, std::max(0.0, std::floor((c - lower[k]) / cellSize) + 1.0));
+      };
+      for (SizeValueType l = 0; l < m_Large.size(); ++l)
+      {
+        const IndexType   t = m_Large[l];
         const IndexType * vt = m_Triangles.data() + 3 * t;
         const double *    st = m_Spheres.data() + 4 * t;
         double            a[9];
         corners(vt, a);
-        m_ReferenceGrid.ForEachOverlapOfBox(boxes.data() + 6 * t, t, [&](SizeValueType u) {
+        const auto test = [&](IndexType u) {
           const IndexType * vu = m_Triangles.data() + 3 * u;
           const double *    su = m_Spheres.data() + 4 * u;
           double            e[3];
           SurfaceCollisionDetail::Subtract(su, st, e);
           const double reach = radius + st[3] + su[3];
-          if ((m_IsLarge[u] && u < t) || SurfaceCollisionDetail::ShareVertex(vt, vu) ||
+          if (SurfaceCollisionDetail::ShareVertex(vt, vu) ||
               SurfaceCollisionDetail::Dot(e, e) >= reach * reach * (1.0 + 1e-12))
           {
             return;
@@ -2460,6 +2598,41 @@ private:
           double b[9];
           corners(vu, b);
           consider(t, u, st, su, boxes.data() + 6 * t, boxes.data() + 6 * u, a, b, out);
+        };
+        // The triangles of the cells: their centroids are within
+        // R + r_t + (the cells' largest radius) of t's along each axis when
+        // their spheres come within R.
+        const double reach = (radius + st[3] + typicalRadius) * (1.0 + 1e-9);
+        uint64_t     lo[3], hi[3];
+        for (unsigned int k = 0; k < 3; ++k)
+        {
+          lo[k] = static_cast<uint64_t>(keyOf(st[k] - reach, k));
+          hi[k] = static_cast<uint64_t>(keyOf(st[k] + reach, k));
+        }
+        for (uint64_t i = lo[0]; i <= hi[0]; ++i)
+        {
+          for (uint64_t j = lo[1]; j <= hi[1]; ++j)
+          {
+            const uint64_t first = Key(i, j, lo[2]);
+            const uint64_t last = Key(i, j, hi[2]);
+            for (auto c = std::lower_bound(base.keys.begin(), base.keys.end(), first);
+                 c != base.keys.end() && *c <= last;
+                 ++c)
+            {
+              const auto cell = static_cast<SizeValueType>(c - base.keys.begin());
+              for (IndexType o = m_CellOffsets[cell]; o < m_CellOffsets[cell + 1]; ++o)
+              {
+                test(m_CellOrder[o]);
+              }
+            }
+          }
+        }
+        // The other large triangles (each pair once).
+        largeGrid.ForEachOverlapOfBox(largeBoxes.data() + 6 * l, l, [&](SizeValueType other) {
+          if (other > l)
+          {
+            test(m_Large[other]);
+          }
         });
       }
     }
@@ -2506,14 +2679,33 @@ private:
     });
     // The pairs sharing one vertex: their gaps at the reference (exact), and
     // the clearance of their triangles against the contact distance.
+    // A bound carried over from the former reference while it has lost at
+    // most SharedLoss R since it was computed (a lower bound lowers the
+    // clearances, so that more triangles are tested, but never misses a
+    // pair); otherwise computed, to SharedSlack R so that the next rebuilds
+    // can carry it.
+    std::atomic<SizeValueType> computed{ 0 };
     parallel(m_SharedGaps.size(), [&](SizeValueType begin, SizeValueType end) {
+      SizeValueType count = 0;
       for (SizeValueType q = begin; q < end; ++q)
       {
         m_SharedExact[q] = 0;
-        // Beyond R the bound does not lower any clearance (at most R - d).
-        m_SharedGaps[q] = RoundDown(this->SharedGapLowerBound(q, x, radius));
+        if (carry)
+        {
+          const float carried = this->CarriedSharedGap(q);
+          if (static_cast<double>(carried) >= static_cast<double>(m_SharedComputed[q]) - SharedLoss * radius)
+          {
+            m_SharedGaps[q] = carried;
+            continue;
+          }
+        }
+        ++count;
+        m_SharedGaps[q] = RoundDown(this->SharedGapLowerBound(q, x, SharedSlack * radius));
+        m_SharedComputed[q] = m_SharedGaps[q];
       }
+      computed += count;
     });
+    m_NumberOfComputedSharedGaps = computed;
     parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
       for (SizeValueType t = begin; t < end; ++t)
       {
@@ -2829,6 +3021,7 @@ private:
   std::vector<IndexType>     m_SharedOfTriangle; // the shared pairs each triangle is in
   std::vector<float>         m_SharedGaps;       // per shared pair: a lower bound of its gap at the reference
   std::vector<uint8_t>       m_SharedExact;      // per shared pair: the bound is the exact gap
+  std::vector<float>         m_SharedComputed;   // per shared pair: its bound when last computed (not carried)
 
   // The index (see the class documentation).
   bool                            m_IndexValid{ false };
@@ -2836,6 +3029,7 @@ private:
   double                          m_ContactDistance{ 0.0 };
   double                          m_Radius{ 0.0 };
   SizeValueType                   m_NumberOfRebuilds{ 0 };
+  SizeValueType                   m_NumberOfComputedSharedGaps{ 0 };
   std::vector<double>             m_Reference;
   std::vector<double>             m_Spheres; // per triangle at the reference: centre, radius
   std::vector<IndexType>          m_CandidateOffsets;
@@ -2850,7 +3044,8 @@ private:
   std::vector<IndexType>          m_Large;          // triangles larger than the cells are made for
   std::vector<uint8_t>            m_IsLarge;        // per triangle
   std::vector<float>              m_ReferenceBoxes; // per triangle at the reference, widened by R/2
-  SurfaceCollisionDetail::BoxGrid m_ReferenceGrid;
+  SurfaceCollisionDetail::BoxGrid m_ReferenceGrid;  // built when a step needs it (EnsureReferenceGrid())
+  bool                            m_ReferenceGridBuilt{ false };
   std::vector<float>              m_CellClearance;
 
   // Per step.

@@ -532,6 +532,56 @@ TEST(SurfaceCollision, TrianglesSharingAVertexDoNotFoldThroughEachOther)
   EXPECT_EQ(lifted[11], 2.0);
 }
 
+TEST(SurfaceCollision, ACarriedSharedGapLosesThePairsMotion)
+{
+  // Two triangles of one fan sharing only v = 0: a in the plane z = 0, b
+  // tilted above it with its far edge 0.2 above a's interior (their gap
+  // 0.2), and a triangle far away (congruent with a) that moves only to
+  // make the index rebuild. Step 1 lowers b's far edge by 0.1 while the far
+  // triangle stretches: the index is rebuilt at the proposed positions and
+  // the pair's bound is carried over (computed at the first rebuild, less
+  // the pair's motion: about 0.1). Step 2 lowers one end of b's far edge
+  // by 0.15, a relative motion that keeps the index, so that the edge
+  // crosses a at about (0.62, 0.33, 0). Only the carried
+  // bound decides whether the pair is tested: one that kept the bound of
+  // the first rebuild (0.2) calls the pair clear and lets b fold through a.
+  std::vector<double> x = {
+    0, 0, 0, 1, 0, 0, 0, 1, 0, 0.9, 0.05, 0.2, 0.05, 0.9, 0.2, 100, 0, 0, 101, 0, 0, 100, 1, 0
+  };
+  const std::vector<uint32_t> triangles = { 0, 1, 2, 0, 3, 4, 5, 6, 7 };
+  const Vec                   v0{ 0, 0, 0 }, a1{ 1, 0, 0 }, a2{ 0, 1, 0 };
+  const auto                  farEdgeHitsA = [&](const std::vector<double> & p) {
+    return SegmentHitsTriangle(Vec{ p[9], p[10], p[11] }, Vec{ p[12], p[13], p[14] }, v0, a1, a2);
+  };
+  itk::SurfaceCollision collision;
+  collision.SetSurface(8, triangles.data(), 3);
+  std::vector<double> y = x;
+  ASSERT_TRUE(collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1).rebuilt);
+  EXPECT_EQ(collision.GetNumberOfComputedSharedGaps(), 1u);
+  EXPECT_EQ(collision.GetNumberOfLargeTriangles(), 0u);
+
+  y[11] -= 0.1;
+  y[14] -= 0.1;
+  y[3 * 6] += 3.0;
+  const auto first = collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1);
+  ASSERT_TRUE(first.rebuilt) << "the far triangle's stretch exceeds the bounds";
+  EXPECT_EQ(first.violations, 0u);
+  EXPECT_EQ(collision.GetNumberOfComputedSharedGaps(), 0u) << "the pair's bound carried over";
+
+  x = y;
+  y[11] -= 0.15;
+  ASSERT_TRUE(farEdgeHitsA(y)) << "unconstrained, b's far edge crosses a";
+  const auto second = collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1);
+  EXPECT_FALSE(second.rebuilt) << "the carried bound decides";
+  EXPECT_GT(second.violations, 0u);
+  EXPECT_FALSE(farEdgeHitsA(y)) << "b's far edge at z = " << y[11];
+  const double * pa[3] = { y.data(), y.data() + 3, y.data() + 6 };
+  const double * pb[3] = { y.data(), y.data() + 9, y.data() + 12 };
+  EXPECT_GT(itk::SurfaceCollisionDetail::SharedVertexGap(pa, 0, pb, 0), 0.0);
+  // One halving: b's far edge at z = 0.1 - 0.075.
+  EXPECT_DOUBLE_EQ(y[11], 0.025);
+}
+
 TEST(SurfaceCollision, DistanceAgreesWithTheIndependentCode)
 {
   // Random pairs: the component's distance and intersection test against
@@ -781,6 +831,49 @@ TEST(SurfaceCollision, RandomStepsWithLargeTrianglesNeverBringPairsCloserThanD)
   const RandomStepsResult stats = RandomSteps(x, triangles, d);
   EXPECT_GE(stats.constrainedSteps, 10u) << "the sheets were pushed into each other";
   EXPECT_EQ(stats.largeTriangles, 2u) << "the two corner triangles";
+}
+
+TEST(SurfaceCollision, ALargeTriangleStopsAtDBelowSmallOnes)
+{
+  // Two sheets 0.3 apart (d = 0.1), the lower one's corner point 12 pulled
+  // out by (1.5, -1.5) (one large triangle, in no cell) and the upper one
+  // moved by (1.6, -1.6) so that its small triangles cover the large one.
+  // Only the pulled-out corner rises, by 0.05 a step: the pairs of the
+  // large triangle with the small ones above it are found only by the
+  // large triangles' candidate search (the cells of the small triangles
+  // around it, at each rebuild), and only those candidates are tested while
+  // its motion stays below R - d. Unconstrained, the corner would pass the
+  // upper sheet.
+  std::vector<double>   x;
+  std::vector<uint32_t> triangles;
+  TwoSheets(0.3, x, triangles);
+  const std::size_t n = x.size() / 3;
+  x[3 * 12] += 1.5;
+  x[3 * 12 + 1] -= 1.5;
+  for (std::size_t i = n / 2; i < n; ++i)
+  {
+    x[3 * i] += 1.6;
+    x[3 * i + 1] -= 1.6;
+  }
+  const double d = 0.1;
+  ASSERT_GE(CheckAllPairs(x, triangles, d).smallestDistance, d);
+  itk::SurfaceCollision collision;
+  collision.SetSurface(n, triangles.data(), triangles.size() / 3);
+  double unconstrained = std::numeric_limits<double>::infinity();
+  for (unsigned int step = 0; step < 10; ++step)
+  {
+    std::vector<double> y = x;
+    y[3 * 12 + 2] += 0.05;
+    unconstrained = std::min(unconstrained, CheckAllPairs(y, triangles, d).smallestDistance);
+    collision.Constrain(x.data(), y.data(), d, nullptr, 1);
+    EXPECT_EQ(collision.GetNumberOfLargeTriangles(), 1u);
+    const BruteForce check = CheckAllPairs(y, triangles, d);
+    ASSERT_EQ(check.intersecting, 0u) << "step " << step;
+    ASSERT_GE(check.smallestDistance, d - 1e-9) << "step " << step;
+    x = y;
+  }
+  EXPECT_LT(unconstrained, d) << "the proposed steps would have come within d";
+  EXPECT_LT(x[3 * 12 + 2], 0.3) << "the corner stopped below the upper sheet";
 }
 
 TEST(SurfaceCollision, ALargeTriangleMovingAloneStopsAtD)
