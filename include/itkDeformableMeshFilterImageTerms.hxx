@@ -139,10 +139,10 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareImageTerms()
     // The image the samplers read: the intensity image itself in 3-D, the
     // slice z = 0 of a 3-D image for a 2-D one (spacing 1 and direction
     // identity along z: the samplers read it bilinearly at (x, y, 0)).
-    const auto                                      region = image->GetBufferedRegion();
-    typename SmoothedIntensityImageType::RegionType region3;
-    typename SmoothedIntensityImageType::PointType  origin3;
-    typename SmoothedIntensityImageType::SpacingType spacing3;
+    const auto                                         region = image->GetBufferedRegion();
+    typename SmoothedIntensityImageType::RegionType    region3;
+    typename SmoothedIntensityImageType::PointType     origin3;
+    typename SmoothedIntensityImageType::SpacingType   spacing3;
     typename SmoothedIntensityImageType::DirectionType direction3;
     direction3.SetIdentity();
     for (unsigned int r = 0; r < 3; ++r)

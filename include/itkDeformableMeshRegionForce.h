@@ -78,7 +78,7 @@ T
 SelectRank(std::vector<T> & values, size_t k)
 {
   static_assert(std::is_floating_point_v<T>, "floating-point values");
-  const size_t n = values.size();
+  const size_t     n = values.size();
   constexpr size_t stride = 16;
   if (n < 64 * stride)
   {

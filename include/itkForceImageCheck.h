@@ -114,8 +114,8 @@ private:
     const SizeValueType n = region.GetNumberOfPixels();
     using ComponentType = typename ForceImageType::PixelType::ValueType;
     constexpr unsigned int components = ForceImageType::PixelType::Dimension;
-    if constexpr (std::is_same_v<ComponentType, float> && sizeof(typename ForceImageType::PixelType) ==
-                                                            components * sizeof(float))
+    if constexpr (std::is_same_v<ComponentType, float> &&
+                  sizeof(typename ForceImageType::PixelType) == components * sizeof(float))
     {
       // Float vectors: squared lengths in float, their largest as the
       // largest of their bits (non-negative floats order as their bits,

@@ -156,7 +156,7 @@ TEST(DeformableMeshRegionForce, SelectRankIsTheValueOfThatRank)
   using itk::DeformableMeshFilterDetail::SelectRank;
   std::mt19937                          random(7);
   std::uniform_real_distribution<float> uniform(-100.0f, 100.0f);
-  const auto reference = [](std::vector<float> v, size_t k) {
+  const auto                            reference = [](std::vector<float> v, size_t k) {
     std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
     return v[k];
   };
@@ -203,12 +203,12 @@ TEST(DeformableMeshRegionForce, SelectRankIsTheValueOfThatRank)
   std::vector<float> infinite(5000);
   for (size_t i = 0; i < infinite.size(); ++i)
   {
-    infinite[i] = i % 50 == 0 ? -std::numeric_limits<float>::infinity()
+    infinite[i] = i % 50 == 0   ? -std::numeric_limits<float>::infinity()
                   : i % 50 == 1 ? std::numeric_limits<float>::infinity()
                                 : uniform(random);
   }
-  for (const size_t k : { size_t{ 0 }, size_t{ 99 }, size_t{ 100 }, size_t{ 2500 }, size_t{ 4899 }, size_t{ 4900 },
-                          size_t{ 4999 } })
+  for (const size_t k :
+       { size_t{ 0 }, size_t{ 99 }, size_t{ 100 }, size_t{ 2500 }, size_t{ 4899 }, size_t{ 4900 }, size_t{ 4999 } })
   {
     std::vector<float> copy = infinite;
     EXPECT_EQ(SelectRank(copy, k), reference(infinite, k)) << "k " << k;

@@ -340,22 +340,23 @@ RunLevel(TFilter *                                       deform,
   const std::string level = std::to_string(numberOfPoints) + " points";
   const auto        iterationsBefore = state.iterations;
   progress.Start("deforming");
-  const auto    start = std::chrono::steady_clock::now();
+  const auto start = std::chrono::steady_clock::now();
   // Only a progress that draws observes the filter: an observer of
   // ProgressEvent makes the filter compute its per-vertex diagnostics at
   // every iteration, a tenth of a small contour's computation.
-  const auto progressTag = !progress.IsEnabled() ? 0UL : deform->AddObserver(itk::ProgressEvent(), [&](const itk::EventObject &) {
-    const auto   total = deform->GetNumberOfIterations();
-    const auto   current = deform->GetCurrentIteration();
-    const double fraction = total > 0 ? static_cast<double>(current) / total : 1.0;
-    if (!progress.Due(fraction))
-    {
-      return;
-    }
-    progress.Update(fraction,
-                    level + ", iteration " + std::to_string(current) + "/" + std::to_string(total) + ", largest step " +
-                      Format(deform->GetLastMaximumDisplacement()) + " mm");
-  });
+  const auto progressTag =
+    !progress.IsEnabled() ? 0UL : deform->AddObserver(itk::ProgressEvent(), [&](const itk::EventObject &) {
+      const auto   total = deform->GetNumberOfIterations();
+      const auto   current = deform->GetCurrentIteration();
+      const double fraction = total > 0 ? static_cast<double>(current) / total : 1.0;
+      if (!progress.Due(fraction))
+      {
+        return;
+      }
+      progress.Update(fraction,
+                      level + ", iteration " + std::to_string(current) + "/" + std::to_string(total) +
+                        ", largest step " + Format(deform->GetLastMaximumDisplacement()) + " mm");
+    });
   unsigned long snapshotTag = 0;
   if (snapshot)
   {
