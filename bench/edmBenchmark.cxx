@@ -549,7 +549,7 @@ MeanEdgeLength(const MeshType * mesh)
 }
 
 void
-BM_EDM_Remeshing(benchmark::State & state)
+RunRemeshing(benchmark::State & state, bool collisions)
 {
   const int64_t      requested = state.range(0);
   constexpr unsigned threads = 2;
@@ -565,6 +565,7 @@ BM_EDM_Remeshing(benchmark::State & state)
   model->SetRigidity(0.1);
   model->SetRemeshingEdgeLength(MeanEdgeLength(input));
   model->SetRemeshingInterval(10);
+  model->SetPreventSelfIntersections(collisions);
   model->SetIterateFromZero(false);
   model->SetNumberOfWorkUnits(4 * threads);
   model->SetNumberOfIterations(1);
@@ -582,9 +583,20 @@ BM_EDM_Remeshing(benchmark::State & state)
   SetCPUTimeCounter(state, ProcessCPUSeconds() - cpuStart, static_cast<double>(vertexIterations));
   state.counters["vertices"] = static_cast<double>(model->GetOutput()->GetNumberOfPoints());
   state.counters["remeshings"] = static_cast<double>(model->GetNumberOfRemeshings());
+  if (collisions)
+  {
+    state.counters["collisions"] = static_cast<double>(model->GetTotalNumberOfCollisionsPrevented());
+  }
   state.counters["vertex_it/s"] =
     benchmark::Counter(static_cast<double>(vertexIterations), benchmark::Counter::kIsRate);
-  state.SetLabel("remeshing every 10 iterations, steps/update=20");
+  state.SetLabel(collisions ? "remeshing every 10 iterations, collision test every iteration, steps/update=20"
+                            : "remeshing every 10 iterations, steps/update=20");
+}
+
+void
+BM_EDM_Remeshing(benchmark::State & state)
+{
+  RunRemeshing(state, false);
 }
 
 // Issue 15's combined speed target: remeshing every 10 iterations (as in
@@ -595,42 +607,7 @@ BM_EDM_Remeshing(benchmark::State & state)
 void
 BM_EDM_CollisionsAndRemeshing(benchmark::State & state)
 {
-  const int64_t      requested = state.range(0);
-  constexpr unsigned threads = 2;
-  ThreadScope        scope(threads);
-  const MeshType *   input = ModelMesh(requested);
-  constexpr unsigned steps = 20;
-
-  auto model = ModelType::New();
-  model->SetInput(input);
-  model->SetForceImage(MeshForceImage());
-  model->SetScaleFactor(0.5);
-  model->SetElasticity(0.3);
-  model->SetRigidity(0.1);
-  model->SetRemeshingEdgeLength(MeanEdgeLength(input));
-  model->SetRemeshingInterval(10);
-  model->SetPreventSelfIntersections(true);
-  model->SetIterateFromZero(false);
-  model->SetNumberOfWorkUnits(4 * threads);
-  model->SetNumberOfIterations(1);
-  model->Update();
-
-  int64_t      vertexIterations = 0;
-  const double cpuStart = ProcessCPUSeconds();
-  for (auto _ : state)
-  {
-    const auto vertices = static_cast<int64_t>(model->GetOutput()->GetNumberOfPoints());
-    model->SetNumberOfIterations(model->GetCurrentIteration() + steps);
-    model->Update();
-    vertexIterations += steps * (vertices + static_cast<int64_t>(model->GetOutput()->GetNumberOfPoints())) / 2;
-  }
-  SetCPUTimeCounter(state, ProcessCPUSeconds() - cpuStart, static_cast<double>(vertexIterations));
-  state.counters["vertices"] = static_cast<double>(model->GetOutput()->GetNumberOfPoints());
-  state.counters["remeshings"] = static_cast<double>(model->GetNumberOfRemeshings());
-  state.counters["collisions"] = static_cast<double>(model->GetTotalNumberOfCollisionsPrevented());
-  state.counters["vertex_it/s"] =
-    benchmark::Counter(static_cast<double>(vertexIterations), benchmark::Counter::kIsRate);
-  state.SetLabel("remeshing every 10 iterations, collision test every iteration, steps/update=20");
+  RunRemeshing(state, true);
 }
 
 // Issue 15 item 5: the plain step on itk::RegularSphereMeshSource's sphere of
