@@ -436,12 +436,31 @@ public:
     const size_t       count = image->GetBufferedRegion().GetNumberOfPixels();
     const size_t       stride = std::max<size_t>(1, count / 1000000) | 1; // odd: no alignment with rows
     std::vector<float> values;
-    values.reserve(count / stride + 1);
-    for (size_t i = 0; i < count; i += stride)
+    if (stride == 1)
     {
-      if (std::isfinite(buffer[i]))
+      // A copy, and the non-finite values removed when a count (a loop the
+      // compiler vectorises) finds any.
+      values.assign(buffer, buffer + count);
+      size_t nonFinite = 0;
+      for (const float value : values)
       {
-        values.push_back(buffer[i]);
+        nonFinite += !(std::abs(value) <= std::numeric_limits<float>::max());
+      }
+      if (nonFinite > 0)
+      {
+        values.erase(std::remove_if(values.begin(), values.end(), [](float v) { return !std::isfinite(v); }),
+                     values.end());
+      }
+    }
+    else
+    {
+      values.reserve(count / stride + 1);
+      for (size_t i = 0; i < count; i += stride)
+      {
+        if (std::isfinite(buffer[i]))
+        {
+          values.push_back(buffer[i]);
+        }
       }
     }
     std::vector<double> result;
@@ -535,8 +554,18 @@ public:
       }
     }
     values.resize(n);
-    values.erase(std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
-                 values.end());
+    // The non-finite values (squares: none is negative) removed when a count
+    // (a loop the compiler vectorises) finds any.
+    size_t nonFinite = 0;
+    for (const double value : values)
+    {
+      nonFinite += !(value <= std::numeric_limits<double>::max());
+    }
+    if (nonFinite > 0)
+    {
+      values.erase(std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }),
+                   values.end());
+    }
     if (values.empty())
     {
       return 0.0;

@@ -186,11 +186,20 @@ private:
              OffsetValueType *       lower,
              OffsetValueType *       upper);
 
-  /** Central differences of \a image on its buffer, threaded over lines:
-   * calls function(offset, derivative) for every pixel, derivative[d] being
-   * (v[+1] - v[-1]) / (2 h_d) along axis d (h_d the spacing when
-   * UseImageSpacing is on, else 1) with a zero-flux boundary, as
-   * GradientImageFilter computes it, without its neighbourhood iterators. */
+  /** Pixels per block of ForEachCentralDifference(). */
+  static constexpr SizeValueType CentralDifferenceBlockLength = 256;
+
+  /** Central differences of \a image on its buffer, threaded over lines of
+   * pixels along x, each line in blocks of up to
+   * CentralDifferenceBlockLength pixels: calls function(line, offset, count,
+   * derivative) for each block, the block being the \a count pixels from
+   * buffer offset \a offset on line number \a line, and
+   * derivative[d * CentralDifferenceBlockLength + k] the derivative along
+   * axis d at its pixel k: (v[+1] - v[-1]) / (2 h_d), h_d the spacing when
+   * UseImageSpacing is on (else 1), with a zero-flux boundary, as
+   * GradientImageFilter computes it, without its neighbourhood iterators.
+   * The blocks of a line are visited in order by one thread; the loops over
+   * a block's pixels vectorise. */
   template <typename TFunction>
   void
   ForEachCentralDifference(const RealImageType * image, const TFunction & function);

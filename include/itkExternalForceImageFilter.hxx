@@ -34,8 +34,34 @@
 #include <new>
 #include <vector>
 
+#if defined(__SSE2__)
+#  include <emmintrin.h>
+#endif
+
 namespace itk
 {
+namespace ExternalForceImageFilterDetail
+{
+/** out[k] = static_cast<float>(std::sqrt(in[k])) for k < count, with SSE2
+ * two at a time (the same values: sqrtpd and cvtpd2ps round as sqrtsd and
+ * cvtsd2ss do). */
+inline void
+SquareRootsToFloat(const double * in, SizeValueType count, float * out)
+{
+  SizeValueType k = 0;
+#if defined(__SSE2__)
+  for (; k + 2 <= count; k += 2)
+  {
+    const __m128 roots = _mm_cvtpd_ps(_mm_sqrt_pd(_mm_loadu_pd(in + k)));
+    _mm_storel_epi64(reinterpret_cast<__m128i *>(out + k), _mm_castps_si128(roots));
+  }
+#endif
+  for (; k < count; ++k)
+  {
+    out[k] = static_cast<float>(std::sqrt(in[k]));
+  }
+}
+} // namespace ExternalForceImageFilterDetail
 
 template <typename TInputImage, typename TOutputImage>
 void
@@ -122,20 +148,30 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::ComputeForceField(const Inp
   typename RealImageType::Pointer smoothed = this->Smooth(input);
   this->UpdateProgress(0.3f);
 
-  // Edge map |grad (G * I)|.
+  // Edge map |grad (G * I)|: the squared norms in double, their roots taken
+  // two at a time (SquareRootsToFloat: the values of std::sqrt, whose errno
+  // path keeps compilers from vectorising it).
   auto edgeMap = RealImageType::New();
   edgeMap->CopyInformation(smoothed);
   edgeMap->SetRegions(smoothed->GetBufferedRegion());
   edgeMap->Allocate();
-  float * edges = edgeMap->GetBufferPointer();
-  this->ForEachCentralDifference(smoothed, [edges](OffsetValueType i, const double * derivative) {
-    double squaredNorm = 0.0;
-    for (unsigned int d = 0; d < ImageDimension; ++d)
-    {
-      squaredNorm += derivative[d] * derivative[d];
-    }
-    edges[i] = static_cast<float>(std::sqrt(squaredNorm));
-  });
+  float *                 edges = edgeMap->GetBufferPointer();
+  constexpr SizeValueType blockLength = CentralDifferenceBlockLength;
+  this->ForEachCentralDifference(
+    smoothed, [edges](SizeValueType, OffsetValueType first, SizeValueType count, const double * derivative) {
+      double squared[blockLength];
+      for (SizeValueType k = 0; k < count; ++k)
+      {
+        double squaredNorm = 0.0;
+        for (unsigned int d = 0; d < ImageDimension; ++d)
+        {
+          const double g = derivative[d * blockLength + k];
+          squaredNorm += g * g;
+        }
+        squared[k] = squaredNorm;
+      }
+      ExternalForceImageFilterDetail::SquareRootsToFloat(squared, count, edges + first);
+    });
   smoothed = nullptr;
 
   if (m_UseGradientVectorFlow)
@@ -151,27 +187,49 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::ComputeForceField(const Inp
   }
 
   // Force grad |grad (G * I)|, in physical axes when UseImageDirection is on.
+  // Without the diffusion, the largest squared norm of the normalisation is
+  // taken on the way, line by line (the same maximum: the order does not
+  // change a maximum, and a NaN, as in std::max, is never taken).
   auto field = OutputImageType::New();
   field->CopyInformation(edgeMap);
   field->SetRegions(edgeMap->GetBufferedRegion());
   field->Allocate();
-  OutputPixelType * forces = field->GetBufferPointer();
-  const bool        useDirection = this->GetUseImageDirection();
-  const auto        direction = edgeMap->GetDirection();
-  this->ForEachCentralDifference(edgeMap, [=](OffsetValueType i, const double * derivative) {
-    for (unsigned int r = 0; r < ImageDimension; ++r)
-    {
-      double component = useDirection ? 0.0 : derivative[r];
-      if (useDirection)
+  OutputPixelType *   forces = field->GetBufferPointer();
+  const bool          useDirection = this->GetUseImageDirection();
+  const auto          direction = edgeMap->GetDirection();
+  const bool          largestOnTheWay = m_NormalizeForces && !m_UseGradientVectorFlow;
+  const SizeValueType numberOfLines =
+    edgeMap->GetBufferedRegion().GetNumberOfPixels() / edgeMap->GetBufferedRegion().GetSize()[0];
+  std::vector<double> lineLargest(largestOnTheWay ? numberOfLines : 0, 0.0);
+  this->ForEachCentralDifference(
+    edgeMap,
+    [=, &lineLargest](SizeValueType line, OffsetValueType first, SizeValueType count, const double * derivative) {
+      OutputPixelType * out = forces + first;
+      for (SizeValueType k = 0; k < count; ++k)
       {
-        for (unsigned int c = 0; c < ImageDimension; ++c)
+        for (unsigned int r = 0; r < ImageDimension; ++r)
         {
-          component += direction(r, c) * derivative[c];
+          double component = useDirection ? 0.0 : derivative[r * blockLength + k];
+          if (useDirection)
+          {
+            for (unsigned int c = 0; c < ImageDimension; ++c)
+            {
+              component += direction(r, c) * derivative[c * blockLength + k];
+            }
+          }
+          out[k][r] = static_cast<OutputValueType>(component);
         }
       }
-      forces[i][r] = static_cast<OutputValueType>(component);
-    }
-  });
+      if (largestOnTheWay)
+      {
+        double largest = lineLargest[line];
+        for (SizeValueType k = 0; k < count; ++k)
+        {
+          largest = std::max(largest, static_cast<double>(out[k].GetSquaredNorm()));
+        }
+        lineLargest[line] = largest;
+      }
+    });
 
   if (m_UseGradientVectorFlow)
   {
@@ -180,19 +238,69 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::ComputeForceField(const Inp
 
   OutputPixelType *   f = field->GetBufferPointer();
   const SizeValueType n = field->GetBufferedRegion().GetNumberOfPixels();
+  using ComponentType = typename OutputPixelType::ValueType;
+  // The largest magnitude of the components, as the largest of their IEEE
+  // bits without the sign (infinities and NaNs above every finite value): a
+  // loop without branches; the non-finite component is looked for only when
+  // there is one. With the normalisation, in the same pass as the scaling.
+  constexpr bool ieeeComponents = std::is_same_v<ComponentType, float> || std::is_same_v<ComponentType, double>;
+  using Bits = std::conditional_t<std::is_same_v<ComponentType, double>, uint64_t, uint32_t>;
+  constexpr Bits        magnitudeMask = ~(Bits{ 1 } << (8 * sizeof(Bits) - 1));
+  Bits                  largestBits = 0;
+  ComponentType *       components = n > 0 ? f[0].GetDataPointer() : nullptr;
+  const SizeValueType   numberOfComponents = n * OutputPixelType::Dimension;
+  const auto            scanComponents = [&]() {
+    if constexpr (ieeeComponents)
+    {
+      for (SizeValueType i = 0; i < numberOfComponents; ++i)
+      {
+        Bits bits;
+        std::memcpy(&bits, components + i, sizeof(bits));
+        bits &= magnitudeMask;
+        largestBits = bits > largestBits ? bits : largestBits;
+      }
+    }
+  };
+  bool scanned = false;
   if (m_NormalizeForces)
   {
     double largest = 0.0;
-    for (SizeValueType i = 0; i < n; ++i)
+    if (largestOnTheWay)
     {
-      largest = std::max(largest, static_cast<double>(f[i].GetSquaredNorm()));
+      for (const double value : lineLargest)
+      {
+        largest = std::max(largest, value);
+      }
+    }
+    else
+    {
+      for (SizeValueType i = 0; i < n; ++i)
+      {
+        largest = std::max(largest, static_cast<double>(f[i].GetSquaredNorm()));
+      }
     }
     if (largest > 0.0)
     {
       const auto scale = static_cast<OutputValueType>(1.0 / std::sqrt(largest));
-      for (SizeValueType i = 0; i < n; ++i)
+      if constexpr (ieeeComponents)
       {
-        f[i] *= scale;
+        for (SizeValueType i = 0; i < numberOfComponents; ++i)
+        {
+          const ComponentType scaled = components[i] * scale;
+          components[i] = scaled;
+          Bits bits;
+          std::memcpy(&bits, &scaled, sizeof(bits));
+          bits &= magnitudeMask;
+          largestBits = bits > largestBits ? bits : largestBits;
+        }
+        scanned = true;
+      }
+      else
+      {
+        for (SizeValueType i = 0; i < n; ++i)
+        {
+          f[i] *= scale;
+        }
       }
     }
   }
@@ -207,28 +315,16 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::ComputeForceField(const Inp
       }
     }
   }
-  // Non-finite components are looked for only when there is one: the
-  // largest magnitude (IEEE bits without the sign: infinities and NaNs above
-  // every finite value) in a loop without branches.
-  using ComponentType = typename OutputPixelType::ValueType;
   bool allFinite = false;
-  if constexpr (std::is_same_v<ComponentType, float> || std::is_same_v<ComponentType, double>)
+  if constexpr (ieeeComponents)
   {
-    using Bits = std::conditional_t<std::is_same_v<ComponentType, float>, uint32_t, uint64_t>;
-    constexpr Bits        magnitudeMask = ~(Bits{ 1 } << (8 * sizeof(Bits) - 1));
-    const ComponentType * components = n > 0 ? f[0].GetDataPointer() : nullptr;
-    const SizeValueType   count = n * OutputPixelType::Dimension;
-    Bits                  largestBits = 0;
-    for (SizeValueType i = 0; i < count; ++i)
+    if (!scanned)
     {
-      Bits bits;
-      std::memcpy(&bits, components + i, sizeof(bits));
-      bits &= magnitudeMask;
-      largestBits = bits > largestBits ? bits : largestBits;
+      scanComponents();
     }
-    ComponentType largest;
-    std::memcpy(&largest, &largestBits, sizeof(largest));
-    allFinite = std::isfinite(largest);
+    ComponentType largestMagnitude;
+    std::memcpy(&largestMagnitude, &largestBits, sizeof(largestMagnitude));
+    allFinite = std::isfinite(largestMagnitude);
   }
   for (SizeValueType i = 0; i < n && !allFinite; ++i)
   {
@@ -429,28 +525,42 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::ForEachCentralDifference(co
       OffsetValueType       lower[ImageDimension];
       OffsetValueType       upper[ImageDimension];
       const OffsetValueType lineStart = LocateLine(line, size, stride, lower, upper);
-      // Pixel x of the line, its neighbours along the line at lower0 and
-      // upper0 (0 at the ends).
-      const auto visit = [&](SizeValueType x, OffsetValueType lower0, OffsetValueType upper0) {
-        const OffsetValueType i = lineStart + static_cast<OffsetValueType>(x);
-        double                derivative[ImageDimension];
-        derivative[0] = (static_cast<double>(v[i + upper0]) - v[i + lower0]) * scale[0];
+      constexpr SizeValueType blockLength = CentralDifferenceBlockLength;
+      double                  derivative[ImageDimension * blockLength];
+      for (SizeValueType x0 = 0; x0 < lineLength; x0 += blockLength)
+      {
+        const SizeValueType count = std::min(blockLength, lineLength - x0);
+        const float *       p = v + lineStart + static_cast<OffsetValueType>(x0);
+        // Along the line: the inner pixels in a loop of constant offsets,
+        // then the line's ends (a missing neighbour is the pixel itself).
+        const bool          firstBlock = x0 == 0;
+        const bool          lastBlock = x0 + count == lineLength;
+        const SizeValueType innerBegin = firstBlock ? 1 : 0;
+        const SizeValueType innerEnd = lastBlock ? count - 1 : count;
+        for (SizeValueType k = innerBegin; k < innerEnd; ++k)
+        {
+          derivative[k] = (static_cast<double>(p[k + 1]) - p[k - 1]) * scale[0];
+        }
+        if (firstBlock)
+        {
+          derivative[0] = (static_cast<double>(p[lineLength > 1 ? 1 : 0]) - p[0]) * scale[0];
+        }
+        if (lastBlock && lineLength > 1)
+        {
+          derivative[count - 1] = (static_cast<double>(p[count - 1]) - p[count - 2]) * scale[0];
+        }
         for (unsigned int d = 1; d < ImageDimension; ++d)
         {
-          derivative[d] = (static_cast<double>(v[i + upper[d]]) - v[i + lower[d]]) * scale[d];
+          const float *         below = p + lower[d];
+          const float *         above = p + upper[d];
+          double *              out = derivative + d * blockLength;
+          const double          s = scale[d];
+          for (SizeValueType k = 0; k < count; ++k)
+          {
+            out[k] = (static_cast<double>(above[k]) - below[k]) * s;
+          }
         }
-        function(i, derivative);
-      };
-      // The ends, then the inner pixels in a loop of constant offsets (the
-      // compiler vectorises it).
-      visit(0, 0, lineLength > 1 ? 1 : 0);
-      for (SizeValueType x = 1; x + 1 < lineLength; ++x)
-      {
-        visit(x, -1, 1);
-      }
-      if (lineLength > 1)
-      {
-        visit(lineLength - 1, -1, 0);
+        function(line, lineStart + static_cast<OffsetValueType>(x0), count, static_cast<const double *>(derivative));
       }
     },
     nullptr);
