@@ -494,6 +494,16 @@ public:
     const double  dx = 2.0 * spacing[0];
     const double  dy = 2.0 * spacing[1];
     const double  dz = 2.0 * spacing[2];
+    // Dividing by a power of two is multiplying by its inverse, exactly: the
+    // same values without a division per voxel (a grid of 1 mm, 0.5 mm...).
+    const auto powerOfTwo = [](double v) {
+      int exponent = 0;
+      return std::frexp(v, &exponent) == 0.5;
+    };
+    const bool byInverse = powerOfTwo(dx) && powerOfTwo(dy) && powerOfTwo(dz);
+    const double inverseX = 1.0 / dx;
+    const double inverseY = 1.0 / dy;
+    const double inverseZ = 1.0 / dz;
     // The squared magnitudes are selected, and the root taken of the one
     // selected: the root, then the rounding to float, keep the order of the
     // values, so the result is that of selecting among the magnitudes (as
@@ -507,6 +517,12 @@ public:
       const double gz = flat ? 0.0 : (buffer[offset + sz] - buffer[offset - sz]) / dz;
       return gx * gx + gy * gy + gz * gz;
     };
+    const auto squaredMagnitudeByInverse = [&](size_t offset) {
+      const double gx = (buffer[offset + sx] - buffer[offset - sx]) * inverseX;
+      const double gy = (buffer[offset + sy] - buffer[offset - sy]) * inverseY;
+      const double gz = flat ? 0.0 : (buffer[offset + sz] - buffer[offset - sz]) * inverseZ;
+      return gx * gx + gy * gy + gz * gz;
+    };
     if (stride == 1)
     {
       // Every inner voxel, row by row (loops the compiler vectorises).
@@ -517,10 +533,22 @@ public:
         for (size_t j = 1; j + 1 < size[1]; ++j)
         {
           const size_t row = k * sz + j * sy;
-          for (size_t i = 1; i + 1 < size[0]; ++i)
+          double *     out = values.data() + n;
+          if (byInverse)
           {
-            values[n++] = squaredMagnitude(row + i);
+            for (size_t i = 1; i + 1 < size[0]; ++i)
+            {
+              out[i - 1] = squaredMagnitudeByInverse(row + i);
+            }
           }
+          else
+          {
+            for (size_t i = 1; i + 1 < size[0]; ++i)
+            {
+              out[i - 1] = squaredMagnitude(row + i);
+            }
+          }
+          n += size[0] > 2 ? size[0] - 2 : 0;
         }
       }
     }

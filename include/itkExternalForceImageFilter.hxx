@@ -361,7 +361,7 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::Smooth(const InputImageType
   constexpr SizeValueType chunk = 4096;
   const SizeValueType     numberOfChunks = (numberOfPixels + chunk - 1) / chunk;
 
-  typename RealImageType::Pointer current = makeImage();
+  typename RealImageType::Pointer current;
   {
     // The largest |intensity| and the first non-finite pixel, chunk by chunk:
     // the largest magnitude without branches (a loop the compiler
@@ -438,7 +438,17 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::Smooth(const InputImageType
       m_IntensityExponent = std::ilogb(largestIntensity);
     }
     const int exponent = m_IntensityExponent;
-    float *   out = current->GetBufferPointer();
+    if constexpr (std::is_same_v<InputImageType, RealImageType>)
+    {
+      // A float image neither scaled nor smoothed is its own smoothed image:
+      // the force field only reads it (no copy).
+      if (exponent == 0 && m_Sigma == 0.0)
+      {
+        return const_cast<RealImageType *>(input);
+      }
+    }
+    current = makeImage();
+    float * out = current->GetBufferPointer();
     threader->ParallelizeArray(
       0,
       numberOfChunks,
