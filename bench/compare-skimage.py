@@ -4,7 +4,8 @@
 
 Usage: /usr/bin/python3 bench/compare-skimage.py BUILD_DIR [--repeat N] [--warm M]
   BUILD_DIR holds bin/edmodel (the project's build tree).
-  --repeat N: time each run N times and keep the fastest (default 3).
+  --repeat N: time each run N times and keep the fastest (default 3); on the
+    synthetic shapes the N rounds interleave the two tools' runs.
   --warm M: edmodel's computation is also timed M times in one process
     (edmodel segment --repeat M), as active_contour's calls are (default 20).
 
@@ -41,7 +42,9 @@ warm); for edmodel its computation (force field + deformation) timed the
 same way, the fastest of --warm runs in one process (edmodel segment
 --repeat), its own figures on stderr in a fresh process (which pays for the
 first use of its code and memory), and the whole process (reading the image,
-writing the contour, starting the program).
+writing the contour, starting the program). On the synthetic shapes each of
+the --repeat rounds runs every case of both tools once, so that a slow phase
+of a shared machine falls on both tools' runs alike.
 """
 import os, re, subprocess, sys, tempfile, time
 import numpy as np
@@ -213,18 +216,32 @@ def main():
         cx, cy = 63.3, 64.1
         outer = extent + 10.0
         init = circle_rc(cx, cy, outer)
-        for sigma in (3.0, 1.0):
-            snake, seconds = run_skimage(image, init, sigma=sigma, **DOCS)
-            rows.append((label, 'active_contour, docs parameters, Gaussian %g px, circle r %g outside' % (sigma, outer),
-                         distances(snake, curve), seconds, None, None, len(snake)))
-        for how, radius, arguments in (('defaults, circle r %g inside' % inner, inner, []),
-                                       ('circle r %g outside, no region force, deflating balloon 0.2 px' % outer,
-                                        outer, ['--region', '0', '--balloon', '-0.2'])):
-            contour, warm, compute, wall = run_edmodel(path, ['--init-circle', '%g,%g,%g' % (cx, cy, radius)] +
-                                                       arguments,
-                                                       'edmodel-%s-%g' % (os.path.basename(path)[:-4], radius))
-            rows.append((label, 'edmodel segment, ' + how, distances(contour, curve), warm, compute, wall,
-                         len(contour)))
+        # The runs of the two tools are interleaved: each of the --repeat
+        # rounds calls active_contour once per Gaussian and runs each edmodel
+        # case once (a fresh process, then one of --repeat WARM runs), and
+        # every time is the best over the rounds, so that a slow phase of a
+        # shared machine (a neighbour's load, a lower clock) falls on both.
+        cases = [('active_contour, docs parameters, Gaussian %g px, circle r %g outside' % (sigma, outer), sigma)
+                 for sigma in (3.0, 1.0)]
+        cases += [('edmodel segment, ' + how, ['--init-circle', '%g,%g,%g' % (cx, cy, radius)] + arguments)
+                  for how, radius, arguments in (('defaults, circle r %g inside' % inner, inner, []),
+                                                 ('circle r %g outside, no region force, deflating balloon 0.2 px'
+                                                  % outer, outer, ['--region', '0', '--balloon', '-0.2']))]
+        results = {}
+        for _ in range(REPEAT):
+            for tool, how in cases:
+                if tool.startswith('active_contour'):
+                    snake, seconds = run_skimage(image, init, repeat=1, sigma=how, **DOCS)
+                    result = (snake, seconds, None, None)
+                else:
+                    result = run_edmodel(path, how, 'edmodel-%s-%d' % (os.path.basename(path)[:-4], len(how)),
+                                         repeat=1)
+                best = results.get(tool)
+                results[tool] = result if best is None else (result[0],) + tuple(
+                    b if a is None else min(a, b) for a, b in zip(result[1:], best[1:]))
+        for tool, _ in cases:
+            points, seconds, fresh, wall = results[tool]
+            rows.append((label, tool, distances(points, curve), seconds, fresh, wall, len(points)))
 
     print('\n| Shape | Tool and start | Points | Mean distance to the true boundary (px) | Largest (px) | '
           'Largest gap, boundary to contour (px) | Time: computation, warm (s) | Computation, fresh process (s) | '
