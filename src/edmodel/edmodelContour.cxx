@@ -173,6 +173,202 @@ Subdivide(const Contours & contours)
   return result;
 }
 
+double
+LongestEdge(const Contours & contours)
+{
+  double longest = 0.0;
+  for (const auto & c : contours)
+  {
+    for (size_t k = 0; k < CountEdges(c); ++k)
+    {
+      longest = std::max(longest, c.points[k].EuclideanDistanceTo(c.points[(k + 1) % c.points.size()]));
+    }
+  }
+  return longest;
+}
+
+/** Twice the signed area of a closed contour (counter-clockwise positive in
+ * a right-handed x, y frame). */
+double
+TwiceSignedArea(const std::vector<Point2> & points)
+{
+  double twice = 0.0;
+  for (size_t k = 0; k < points.size(); ++k)
+  {
+    const auto & a = points[k];
+    const auto & b = points[(k + 1) % points.size()];
+    twice += a[0] * b[1] - a[1] * b[0];
+  }
+  return twice;
+}
+
+/** A crossing of two edges of closed contour \a c that share no point: the
+ * edges (k, k + 1) and (m, m + 1), k < m, and where they cross. Edges are
+ * swept in order of their smallest x (so O(n log n) plus the pairs whose
+ * x ranges overlap); a touching (collinear overlap, an end on the other edge)
+ * counts as a crossing. False when there is none. */
+bool
+FindCrossing(const Contour & c, size_t & firstEdge, size_t & secondEdge, Point2 & where)
+{
+  const size_t n = c.points.size();
+  if (!c.closed || n < 4)
+  {
+    return false;
+  }
+  struct Edge
+  {
+    double lowX;
+    double highX;
+    size_t index;
+  };
+  std::vector<Edge> edges(n);
+  for (size_t k = 0; k < n; ++k)
+  {
+    const auto & a = c.points[k];
+    const auto & b = c.points[(k + 1) % n];
+    edges[k] = { std::min(a[0], b[0]), std::max(a[0], b[0]), k };
+  }
+  std::sort(edges.begin(), edges.end(), [](const Edge & a, const Edge & b) { return a.lowX < b.lowX; });
+  const auto cross = [](const Point2 & o, const Point2 & a, const Point2 & b) {
+    return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+  };
+  bool   found = false;
+  size_t bestFirst = 0;
+  size_t bestSecond = 0;
+  for (size_t i = 0; i < n; ++i)
+  {
+    for (size_t j = i + 1; j < n && edges[j].lowX <= edges[i].highX; ++j)
+    {
+      size_t k = edges[i].index;
+      size_t m = edges[j].index;
+      if (k > m)
+      {
+        std::swap(k, m);
+      }
+      // Neighbouring edges share a point.
+      if (m == k + 1 || (k == 0 && m == n - 1))
+      {
+        continue;
+      }
+      const Point2 & a = c.points[k];
+      const Point2 & b = c.points[(k + 1) % n];
+      const Point2 & p = c.points[m];
+      const Point2 & q = c.points[(m + 1) % n];
+      if (std::max(p[1], q[1]) < std::min(a[1], b[1]) || std::max(a[1], b[1]) < std::min(p[1], q[1]))
+      {
+        continue;
+      }
+      const double d1 = cross(a, b, p);
+      const double d2 = cross(a, b, q);
+      const double d3 = cross(p, q, a);
+      const double d4 = cross(p, q, b);
+      if (!((d1 <= 0.0 && d2 >= 0.0) || (d1 >= 0.0 && d2 <= 0.0)) ||
+          !((d3 <= 0.0 && d4 >= 0.0) || (d3 >= 0.0 && d4 <= 0.0)))
+      {
+        continue;
+      }
+      // The first crossing along the contour: the smallest first edge, then
+      // the smallest second one (the same pair whatever the sweep's order).
+      if (!found || k < bestFirst || (k == bestFirst && m < bestSecond))
+      {
+        found = true;
+        bestFirst = k;
+        bestSecond = m;
+        const double denominator = d1 - d2;
+        const double t = denominator != 0.0 ? d1 / denominator : 0.5;
+        where = MakePoint(p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1]));
+      }
+    }
+  }
+  firstEdge = bestFirst;
+  secondEdge = bestSecond;
+  return found;
+}
+
+/** The closed contours without their loops: at a crossing of two of its
+ * edges a contour is two loops joined at the crossing; the one kept turns
+ * the way the whole contour turns (the sign of its area) and encloses the
+ * larger area that way, the other (a fold, or the inside of an obstacle the
+ * contour grew around and closed behind) is dropped; repeated until no two
+ * edges cross. A loop of fewer than 3 points is dropped whole. Open
+ * contours are left as they are. Returns the number of loops removed. */
+size_t
+RemoveLoops(Contours & contours)
+{
+  size_t removed = 0;
+  for (auto & c : contours)
+  {
+    if (!c.closed)
+    {
+      continue;
+    }
+    const double orientation = TwiceSignedArea(c.points) >= 0.0 ? 1.0 : -1.0;
+    size_t       k = 0;
+    size_t       m = 0;
+    Point2       where;
+    while (FindCrossing(c, k, m, where))
+    {
+      // Loop A: the crossing, then points k + 1 .. m; loop B: the crossing,
+      // then points m + 1 .. n - 1, 0 .. k.
+      const size_t        n = c.points.size();
+      std::vector<Point2> a{ where };
+      a.insert(a.end(), c.points.begin() + static_cast<std::ptrdiff_t>(k + 1),
+               c.points.begin() + static_cast<std::ptrdiff_t>(m + 1));
+      std::vector<Point2> b{ where };
+      b.insert(b.end(), c.points.begin() + static_cast<std::ptrdiff_t>(m + 1), c.points.end());
+      b.insert(b.end(), c.points.begin(), c.points.begin() + static_cast<std::ptrdiff_t>(k + 1));
+      const double areaA = orientation * TwiceSignedArea(a);
+      const double areaB = orientation * TwiceSignedArea(b);
+      c.points = (a.size() >= 3 && (b.size() < 3 || areaA > areaB)) ? a : b;
+      ++removed;
+      if (c.points.size() < 3 || c.points.size() >= n + 1)
+      {
+        break;
+      }
+    }
+  }
+  return removed;
+}
+
+/** Closed contours resampled at equal arc lengths of about \a spacing (at
+ * least 8 points), from their first point; open contours unchanged. */
+Contours
+Resample(const Contours & contours, double spacing)
+{
+  Contours result = contours;
+  for (auto & c : result)
+  {
+    const double length = Length(c);
+    if (!c.closed || !(length > 0.0) || !(spacing > 0.0))
+    {
+      continue;
+    }
+    const auto          count = static_cast<size_t>(std::max(8.0, std::round(length / spacing)));
+    const double        step = length / static_cast<double>(count);
+    std::vector<Point2> points;
+    points.reserve(count);
+    size_t edge = 0;
+    double edgeStart = 0.0; // arc length at the start of edge
+    double edgeLength = c.points[0].EuclideanDistanceTo(c.points[1 % c.points.size()]);
+    for (size_t i = 0; i < count; ++i)
+    {
+      const double s = static_cast<double>(i) * step;
+      while (edge + 1 < c.points.size() && s > edgeStart + edgeLength)
+      {
+        edgeStart += edgeLength;
+        ++edge;
+        edgeLength = c.points[edge].EuclideanDistanceTo(c.points[(edge + 1) % c.points.size()]);
+      }
+      const double t = edgeLength > 0.0 ? std::min(1.0, (s - edgeStart) / edgeLength) : 0.0;
+      const auto & a = c.points[edge];
+      const auto & b = c.points[(edge + 1) % c.points.size()];
+      points.push_back(MakePoint(a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])));
+    }
+    c.points = points;
+  }
+  return result;
+}
+
 /** The contours as the filter's mesh: the points numbered contour after
  * contour, a closed contour as one polygon cell, an open one as a chain of
  * line cells. */
@@ -1013,7 +1209,20 @@ DeformContours(const Image2DType *     image,
   // One filter for all levels: its smoothed intensity image and statistics
   // are kept from one level to the next when the region sigma is the same.
   auto deform = ContourFilterType::New();
-  for (unsigned int stage = 0;; ++stage)
+  // Closed contours pushed outward (region force or balloon) are watched
+  // every ContourCheckInterval iterations: a contour that grew around an
+  // obstacle (on a brain slice, the ventricles the initial circle sits
+  // between) closes behind it by crossing itself, and its points, left with
+  // edges of tens of pixels, tangle further (it ended wound four times around
+  // the brain). At a crossing the level stops, the contour loses its loops
+  // (RemoveLoops) and is resampled, and the level starts again from it; so
+  // does the capture level when its longest edge exceeds
+  // ContourCaptureStretch times the initial mean edge.
+  const bool   watch = !open && (schedule.regionWeight > 0.0 || o.balloon != 0.0);
+  const double initialMeanEdge = MeanEdgeLength(initial);
+  unsigned int restarts = 0;
+  itk::SizeValueType stageIterationsBefore = 0; // of the current stage, before its restarts
+  for (unsigned int stage = 0;;)
   {
     // Unlike the 3-D sphere, the initial circle is often already as fine as
     // --edge-length (a small circle inside the object): the first level is
@@ -1023,24 +1232,71 @@ DeformContours(const Image2DType *     image,
     deform->SetInput(ToMesh(stageInput));
     deform->SetForceImage(result.force);
     deform->SetIntensityImage(intensity);
-    ConfigureLevel(deform.GetPointer(), o, schedule, state, stage, last, MeanEdgeLength(stageInput));
-    RunLevel(deform.GetPointer(),
-             o,
-             schedule,
-             progress,
-             CountPoints(stageInput),
-             state,
-             snapshot ? std::function<void(itk::SizeValueType)>([&](itk::SizeValueType iteration) {
-               snapshot(FromMesh(deform->GetOutput(), stageInput), iteration);
-             })
-                      : std::function<void(itk::SizeValueType)>());
+    const double stageMeanEdge = MeanEdgeLength(stageInput);
+    ConfigureLevel(deform.GetPointer(), o, schedule, state, stage, last, stageMeanEdge);
+    const auto cap = deform->GetNumberOfIterations();
+    deform->SetNumberOfIterations(cap > stageIterationsBefore ? cap - stageIterationsBefore : 1);
+    const bool capture = stage == 0 && !last;
+    Contours   repaired;
+    const auto checkpoint = [&]() {
+      Contours current = FromMesh(deform->GetOutput(), stageInput);
+      size_t   k = 0;
+      size_t   m = 0;
+      Point2   where;
+      bool     crossing = false;
+      for (const auto & c : current)
+      {
+        crossing = crossing || FindCrossing(c, k, m, where);
+      }
+      const bool stretched = capture && LongestEdge(current) > defaults::ContourCaptureStretch * initialMeanEdge;
+      if (!crossing && !stretched)
+      {
+        return false;
+      }
+      const size_t loops = RemoveLoops(current);
+      // The capture keeps at most twice the initial spacing; a refined
+      // level its own.
+      const double spacing = capture ? std::min(MeanEdgeLength(current), 2.0 * initialMeanEdge) : stageMeanEdge;
+      repaired = Resample(current, spacing);
+      progress.Note("contour " + std::string(loops > 0 ? "crossed itself: " + std::to_string(loops) + " loop(s) removed, "
+                                                       : "stretched: ") +
+                    "resampled to " + std::to_string(CountPoints(repaired)) + " points");
+      return true;
+    };
+    const bool restart =
+      RunLevel(deform.GetPointer(),
+               o,
+               schedule,
+               progress,
+               CountPoints(stageInput),
+               state,
+               snapshot ? std::function<void(itk::SizeValueType)>([&](itk::SizeValueType iteration) {
+                 snapshot(FromMesh(deform->GetOutput(), stageInput), iteration);
+               })
+                        : std::function<void(itk::SizeValueType)>(),
+               watch && restarts < defaults::ContourMaximumRestarts ? defaults::ContourCheckInterval : 0,
+               std::function<bool()>(checkpoint));
     result.iterations = state.iterations;
     result.converged = state.converged;
     result.lastMaximumDisplacement = state.lastMaximumDisplacement;
-    const Contours output = FromMesh(deform->GetOutput(), stageInput);
+    if (restart)
+    {
+      ++restarts;
+      stageIterationsBefore += deform->GetCurrentIteration();
+      stageInput = repaired;
+      continue;
+    }
+    stageIterationsBefore = 0;
+    const unsigned int ran = stage++;
+    Contours           output = FromMesh(deform->GetOutput(), stageInput);
+    if (watch)
+    {
+      // No loop is left in the result, whatever the restarts' count.
+      RemoveLoops(output);
+    }
     const bool     fine = !(MeanEdgeLength(output) > 1.5 * schedule.edgeLength) ||
                       2.0 * static_cast<double>(CountPoints(output)) > maximumPoints;
-    if (last || (stage > 0 && fine))
+    if (last || (ran > 0 && fine))
     {
       result.contours = output;
       break;

@@ -326,17 +326,24 @@ ConfigureLevel(TFilter *              deform,
  * of points), snapshots every --snapshot-every iterations and at the end
  * (`snapshot(iteration)` is called with the total iteration count; the
  * caller reads the filter's output), the intensity model's notes; updates
- * `state`. Throws Error when the filter throws. */
+ * `state`. With a `checkpoint`, the level runs in updates of `checkEvery`
+ * iterations (the filter's continuation, IterateFromZero off) and
+ * checkpoint() is called after each (the output then holds the mesh of that
+ * iteration); when it returns true the level stops there and RunLevel
+ * returns true. Throws Error when the filter throws. */
 template <typename TFilter>
-void
+bool
 RunLevel(TFilter *                                       deform,
          const SegmentOptions &                          o,
          const LevelSchedule &                           s,
          Progress &                                      progress,
          itk::SizeValueType                              numberOfPoints,
          LevelState &                                    state,
-         const std::function<void(itk::SizeValueType)> & snapshot)
+         const std::function<void(itk::SizeValueType)> & snapshot,
+         itk::SizeValueType                              checkEvery = 0,
+         const std::function<bool()> &                   checkpoint = std::function<bool()>())
 {
+  const itk::SizeValueType cap = deform->GetNumberOfIterations();
   const std::string level = std::to_string(numberOfPoints) + " points";
   const auto        iterationsBefore = state.iterations;
   progress.Start("deforming");
@@ -346,7 +353,7 @@ RunLevel(TFilter *                                       deform,
   // every iteration, a tenth of a small contour's computation.
   const auto progressTag =
     !progress.IsEnabled() ? 0UL : deform->AddObserver(itk::ProgressEvent(), [&](const itk::EventObject &) {
-      const auto   total = deform->GetNumberOfIterations();
+      const auto   total = cap;
       const auto   current = deform->GetCurrentIteration();
       const double fraction = total > 0 ? static_cast<double>(current) / total : 1.0;
       if (!progress.Due(fraction))
@@ -377,9 +384,35 @@ RunLevel(TFilter *                                       deform,
       deform->RemoveObserver(snapshotTag);
     }
   };
+  bool stopped = false;
   try
   {
-    deform->Update();
+    if (checkpoint && checkEvery > 0)
+    {
+      // A new input resets the filter at its first update; the later ones
+      // continue where it stopped.
+      const bool fromZero = deform->GetIterateFromZero();
+      deform->IterateFromZeroOff();
+      for (itk::SizeValueType target = std::min(cap, checkEvery);; target = std::min(cap, target + checkEvery))
+      {
+        deform->SetNumberOfIterations(target);
+        deform->Update();
+        if (checkpoint())
+        {
+          stopped = true;
+          break;
+        }
+        if (deform->GetConverged() || deform->GetCurrentIteration() < target || target >= cap)
+        {
+          break;
+        }
+      }
+      deform->SetIterateFromZero(fromZero);
+    }
+    else
+    {
+      deform->Update();
+    }
   }
   catch (const itk::ExceptionObject & exception)
   {
@@ -416,11 +449,13 @@ RunLevel(TFilter *                                       deform,
           " " + s.pointsWord + " moving" + (s.convergenceAlongNormals ? " along their normals" : "") + " by "
       : std::string(s.convergenceAlongNormals ? "largest step along the normals below " : "largest step below ");
   progress.Finish(std::to_string(deform->GetCurrentIteration()) + " iterations on " + level + ", " +
-                  (state.converged ? "converged (" + quiet + Format(deform->GetConvergenceTolerance()) + " mm for " +
-                                       std::to_string(o.convergenceWindow) + " iterations)"
-                                   : std::string("iteration cap reached")) +
+                  (stopped            ? std::string("stopped to repair the contour")
+                   : state.converged ? "converged (" + quiet + Format(deform->GetConvergenceTolerance()) + " mm for " +
+                                         std::to_string(o.convergenceWindow) + " iterations)"
+                                     : std::string("iteration cap reached")) +
                   ", last largest step " + Format(state.lastMaximumDisplacement) + " mm (" + Format(seconds, 2) +
                   " s)");
+  return stopped;
 }
 
 } // namespace edm

@@ -12,9 +12,12 @@
 //   edmodelTestTool flat IMG            (a 2-D image)
 //   edmodelTestTool ellipse2d IMG --size X,Y --spacing X,Y --origin X,Y --center X,Y --radii A,B
 //                   [--angle RAD] [--inside V] [--outside V] [--pixel uchar|float] [--slab 1]
-//                   (anti-aliased 2-D ellipse, the a-axis at RAD from x; --slab: a volume of one slice)
+//                   [--holes X1,Y1,R1,X2,Y2,R2,...]
+//                   (anti-aliased 2-D ellipse, the a-axis at RAD from x; --slab: a volume of one slice;
+//                   --holes: disks of the outside value inside it)
 //   edmodelTestTool measure-contour CONTOUR(.csv|.vtk) --center X,Y --radii A,B [--angle RAD]
 //                   --max-mean D --max-max D [--min-points N]
+//                   (also fails when two edges of the closed contour that share no point cross)
 //   edmodelTestTool contour-csv CSV --points X1,Y1,X2,Y2,...   (one contour, x,y per line)
 //   edmodelTestTool check-ends CONTOUR(.csv|.vtk) --first X,Y --last X,Y   (exactly these ends)
 //   edmodelTestTool check-overlay PNG --min-size N --min-red N
@@ -316,6 +319,19 @@ WriteEllipse2D(const std::string & path, const std::map<std::string, std::string
   const double                    angle = options.count("--angle") ? std::stod(options.at("--angle")) : 0.0;
   const double                    inside = options.count("--inside") ? std::stod(options.at("--inside")) : 200.0;
   const double                    outside = options.count("--outside") ? std::stod(options.at("--outside")) : 40.0;
+  std::vector<double>             holes;
+  if (options.count("--holes"))
+  {
+    std::stringstream list(options.at("--holes"));
+    for (std::string item; std::getline(list, item, ',');)
+    {
+      holes.push_back(std::stod(item));
+    }
+    if (holes.empty() || holes.size() % 3 != 0)
+    {
+      throw std::runtime_error("--holes needs X,Y,R triples");
+    }
+  }
   typename ImageType::SizeType    imageSize;
   typename ImageType::SpacingType imageSpacing;
   typename ImageType::PointType   imageOrigin;
@@ -345,7 +361,12 @@ WriteEllipse2D(const std::string & path, const std::map<std::string, std::string
         const double y = origin[1] + (it.GetIndex()[1] - 0.5 + (b + 0.5) / sub) * spacing[1] - c[1];
         const double u = std::cos(angle) * x + std::sin(angle) * y;
         const double v = -std::sin(angle) * x + std::cos(angle) * y;
-        count += (u / r[0]) * (u / r[0]) + (v / r[1]) * (v / r[1]) <= 1.0 ? 1 : 0;
+        bool         in = (u / r[0]) * (u / r[0]) + (v / r[1]) * (v / r[1]) <= 1.0;
+        for (size_t h = 0; h < holes.size() && in; h += 3)
+        {
+          in = std::hypot(x + c[0] - holes[h], y + c[1] - holes[h + 1]) > holes[h + 2];
+        }
+        count += in ? 1 : 0;
       }
     }
     const double fraction = static_cast<double>(count) / (sub * sub);
@@ -458,12 +479,44 @@ MeasureContour(const std::string & path, const std::map<std::string, std::string
     maximum = std::max(maximum, d);
   }
   mean /= std::max<size_t>(1, points.size());
+  // Edges of the closed contour that share no point and cross (or touch):
+  // all pairs, independently of edmodel's own test.
+  const size_t n = points.size();
+  size_t       crossings = 0;
+  const auto   cross = [](const std::array<double, 2> & o, const std::array<double, 2> & a,
+                        const std::array<double, 2> & b) {
+    return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+  };
+  for (size_t k = 0; k < n && n >= 4; ++k)
+  {
+    for (size_t m = k + 2; m < n; ++m)
+    {
+      if (k == 0 && m == n - 1)
+      {
+        continue;
+      }
+      const auto & a = points[k];
+      const auto & b = points[(k + 1) % n];
+      const auto & p = points[m];
+      const auto & q = points[(m + 1) % n];
+      const double d1 = cross(a, b, p);
+      const double d2 = cross(a, b, q);
+      const double d3 = cross(p, q, a);
+      const double d4 = cross(p, q, b);
+      if (((d1 <= 0.0 && d2 >= 0.0) || (d1 >= 0.0 && d2 <= 0.0)) && ((d3 <= 0.0 && d4 >= 0.0) || (d3 >= 0.0 && d4 <= 0.0)))
+      {
+        ++crossings;
+      }
+    }
+  }
   const double maxMean = Numbers(options, "--max-mean", 1)[0];
   const double maxMax = Numbers(options, "--max-max", 1)[0];
   const double minPoints = options.count("--min-points") ? std::stod(options.at("--min-points")) : 3.0;
   std::cout << path << ": " << points.size() << " points; distance to the ellipse: mean " << mean << " mm, max "
-            << maximum << " mm (limits " << maxMean << ", " << maxMax << ")" << std::endl;
-  return mean <= maxMean && maximum <= maxMax && points.size() >= minPoints ? EXIT_SUCCESS : EXIT_FAILURE;
+            << maximum << " mm (limits " << maxMean << ", " << maxMax << "); " << crossings
+            << " pair(s) of crossing edges" << std::endl;
+  return mean <= maxMean && maximum <= maxMax && points.size() >= minPoints && crossings == 0 ? EXIT_SUCCESS
+                                                                                               : EXIT_FAILURE;
 }
 
 int
