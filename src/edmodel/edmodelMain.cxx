@@ -692,6 +692,8 @@ PrintSegmentHelp(std::ostream & os, const OptionTable & table)
         "--init-circle X,Y,R or --init-contour FILE instead of a sphere or a mesh, with the same filters,\n"
         "options and defaults (a circle of --circle-points points refined to --edge-length; the region\n"
         "force estimated inside the initial circle), except the elasticity, tangential on contours.\n"
+        "A closed contour that grows around an obstacle and crosses itself loses its loops and is\n"
+        "resampled (checked every 10 iterations; the written contour has no crossing edges).\n"
         "--output .vtk/.vtp/.csv writes the contour, --overlay-png draws it over the image. An open\n"
         "contour (--open, or an open polyline) has no region force or balloon; --fixed-boundary keeps\n"
         "its ends. --init-sphere and --init-mesh need a 3-D image, --init-circle and --init-contour a\n"
