@@ -947,6 +947,13 @@ private:
   // Force sampler, prepared at each update: continuous index
   // c = M (x - origin) - bufferStart, with M's columns as vectors.
   const ForcePixelType *                                   m_ForceBuffer{ nullptr };
+  /** The force image the sampler was set up for: its address, modification
+   * times (of the image and of its buffer) and buffered region; a
+   * continuation of the same run keeps the sampler. */
+  const ForceImageType *                                   m_SampledForceImage{ nullptr };
+  ModifiedTimeType                                         m_SampledForceTime{ 0 };
+  ModifiedTimeType                                         m_SampledForceBufferTime{ 0 };
+  typename ForceImageType::RegionType                      m_SampledForceRegion;
   double                                                   m_PhysicalToIndex[3][3]{};
   double                                                   m_ForceOrigin[3]{};
   double                                                   m_BufferStart[3]{};

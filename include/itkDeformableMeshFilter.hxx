@@ -136,6 +136,16 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareForceSampler()
     itkExceptionMacro("The force image has no buffered region (no pixel in memory): allocate it or update the "
                       "filter that produces it.");
   }
+  if (image == m_SampledForceImage && image->GetBufferPointer() == m_ForceBuffer &&
+      image->GetMTime() == m_SampledForceTime && image->GetPixelContainer()->GetMTime() == m_SampledForceBufferTime &&
+      region == m_SampledForceRegion)
+  {
+    return;
+  }
+  m_SampledForceImage = image;
+  m_SampledForceTime = image->GetMTime();
+  m_SampledForceBufferTime = image->GetPixelContainer()->GetMTime();
+  m_SampledForceRegion = region;
   m_ForceBuffer = image->GetBufferPointer();
 
   // A 2-D image is sampled as the slice z = 0 of a 3-D one: the points'

@@ -221,8 +221,10 @@ DeformableMeshFilter<TMesh, TForceImage>::PrepareImageTerms()
     m_IntensityQuantiles[0] = quantiles[0];
     m_IntensityQuantiles[1] = quantiles[1];
     m_IntensityGradientQuantile = RegionForceType::GradientQuantile(m_SmoothedIntensity, 0.99);
+    // The sampler's physical-to-index transform (a matrix inverse) with it:
+    // the continuations of a run (one more step per update) keep both.
+    m_IntensitySampler.SetImage(m_SmoothedIntensity);
   }
-  m_IntensitySampler.SetImage(m_SmoothedIntensity);
   const auto & spacing = image->GetSpacing();
   m_BackgroundStep = spacing[0];
   for (unsigned int d = 1; d < PointDimension; ++d)

@@ -194,6 +194,12 @@ public:
         m_Offset[r] += m_Matrix[r][c] * image->GetOrigin()[c];
       }
     }
+    // A 2-D image embedded in 3-D (the contours' case) whose transform
+    // leaves z alone exactly: the in-plane index needs only the x and y
+    // columns, and index z is physical z (the same values as the general
+    // product, whose z terms are exact zeros).
+    m_Planar = m_Flat && m_Matrix[0][2] == 0.0 && m_Matrix[1][2] == 0.0 && m_Matrix[2][0] == 0.0 &&
+               m_Matrix[2][1] == 0.0 && m_Matrix[2][2] == 1.0 && m_Offset[2] == 0.0;
   }
 
   /** The trilinear sample at physical point x; NaN outside the image. */
@@ -246,9 +252,20 @@ private:
   SampleFlat(const double * x) const
   {
     double c[3];
-    for (unsigned int r = 0; r < 3; ++r)
+    if (m_Planar)
     {
-      c[r] = m_Matrix[r][0] * x[0] + m_Matrix[r][1] * x[1] + m_Matrix[r][2] * x[2] - m_Offset[r];
+      for (unsigned int r = 0; r < 2; ++r)
+      {
+        c[r] = m_Matrix[r][0] * x[0] + m_Matrix[r][1] * x[1] - m_Offset[r];
+      }
+      c[2] = x[2];
+    }
+    else
+    {
+      for (unsigned int r = 0; r < 3; ++r)
+      {
+        c[r] = m_Matrix[r][0] * x[0] + m_Matrix[r][1] * x[1] + m_Matrix[r][2] * x[2] - m_Offset[r];
+      }
     }
     if (!(c[0] >= -0.5 && c[0] < static_cast<double>(m_Size[0]) - 0.5 && c[1] >= -0.5 &&
           c[1] < static_cast<double>(m_Size[1]) - 0.5 && c[2] >= -0.5 && c[2] < 0.5))
@@ -272,6 +289,7 @@ private:
 
   const float * m_Buffer{ nullptr };
   bool          m_Flat{ false };
+  bool          m_Planar{ false };
   double        m_Matrix[3][3]{};
   double        m_Offset[3]{};
   int64_t       m_Size[3]{};

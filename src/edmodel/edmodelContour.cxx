@@ -1263,6 +1263,7 @@ DeformContours(const Image2DType *     image,
                     "resampled to " + std::to_string(CountPoints(repaired)) + " points");
       return true;
     };
+    const bool checked = watch && restarts < defaults::ContourMaximumRestarts;
     const bool restart =
       RunLevel(deform.GetPointer(),
                o,
@@ -1274,7 +1275,7 @@ DeformContours(const Image2DType *     image,
                  snapshot(FromMesh(deform->GetOutput(), stageInput), iteration);
                })
                         : std::function<void(itk::SizeValueType)>(),
-               watch && restarts < defaults::ContourMaximumRestarts ? defaults::ContourCheckInterval : 0,
+               checked ? defaults::ContourCheckInterval : 0,
                std::function<bool()>(checkpoint));
     result.iterations = state.iterations;
     result.converged = state.converged;
@@ -1289,9 +1290,10 @@ DeformContours(const Image2DType *     image,
     stageIterationsBefore = 0;
     const unsigned int ran = stage++;
     Contours           output = FromMesh(deform->GetOutput(), stageInput);
-    if (watch)
+    if (watch && !checked)
     {
-      // No loop is left in the result, whatever the restarts' count.
+      // No loop is left in the result, whatever the restarts' count (a
+      // checked level's last checkpoint saw its output).
       RemoveLoops(output);
     }
     const bool     fine = !(MeanEdgeLength(output) > 1.5 * schedule.edgeLength) ||

@@ -166,8 +166,11 @@ ComputeForceField(const typename TForceFilter::InputImageType * image,
   force->SetGradientVectorFlowRegularization(o.gradientVectorFlowRegularization);
   force->SetGradientVectorFlowIterations(o.gradientVectorFlowIterations);
   progress.Start("force field");
-  force->AddObserver(itk::ProgressEvent(),
-                     [&](const itk::EventObject &) { progress.Update(force->GetProgress(), ""); });
+  if (progress.IsEnabled())
+  {
+    force->AddObserver(itk::ProgressEvent(),
+                       [&](const itk::EventObject &) { progress.Update(force->GetProgress(), ""); });
+  }
   const auto start = std::chrono::steady_clock::now();
   try
   {
@@ -177,9 +180,13 @@ ComputeForceField(const typename TForceFilter::InputImageType * image,
   {
     throw Error("force field: " + OneLine(exception.GetDescription()));
   }
-  progress.Finish("sigma " + Format(sigma) + " mm" + (o.gradientVectorFlow ? ", gradient vector flow" : "") +
+  if (progress.IsEnabled())
+  {
+    progress.Finish("sigma " + Format(sigma) + " mm" + (o.gradientVectorFlow ? ", gradient vector flow" : "") +
                   (o.normalizeForces ? ", normalised" : ", not normalised") + " (" +
-                  Format(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2) + " s)");
+                    Format(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2) +
+                    " s)");
+  }
   typename TForceFilter::OutputImageType::Pointer field = force->GetOutput();
   field->DisconnectPipeline();
   return field;
@@ -425,10 +432,13 @@ RunLevel(TFilter *                                       deform,
     state.haveModel = true;
     state.model[0] = deform->GetObjectIntensityMedian();
     state.model[1] = deform->GetObjectIntensitySpread();
-    progress.Note("region force: object intensity median " + Format(state.model[0], 4) + ", spread " +
-                  Format(state.model[1], 3) + " (estimated inside the initial " + s.initialWhat + ")");
+    if (progress.IsEnabled())
+    {
+      progress.Note("region force: object intensity median " + Format(state.model[0], 4) + ", spread " +
+                    Format(state.model[1], 3) + " (estimated inside the initial " + s.initialWhat + ")");
+    }
   }
-  if (deform->GetRegionWeight() > 0.0)
+  if (deform->GetRegionWeight() > 0.0 && progress.IsEnabled())
   {
     progress.Note("region force: intensity range [" + Format(deform->GetObjectIntensityLower(), 4) + ", " +
                   Format(deform->GetObjectIntensityUpper(), 4) + "], transition width " +
@@ -441,6 +451,11 @@ RunLevel(TFilter *                                       deform,
   state.iterations += deform->GetCurrentIteration();
   state.converged = deform->GetConverged();
   state.lastMaximumDisplacement = deform->GetLastMaximumDisplacement();
+  if (!progress.IsEnabled())
+  {
+    // The summary's text (a tenth of a small contour's set-up) is not built.
+    return stopped;
+  }
   const double      seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::string quiet =
     o.convergenceFraction > 0.0
