@@ -946,7 +946,7 @@ private:
 
   // Force sampler, prepared at each update: continuous index
   // c = M (x - origin) - bufferStart, with M's columns as vectors.
-  const ForcePixelType *                                   m_ForceBuffer{ nullptr };
+  const ForcePixelType * m_ForceBuffer{ nullptr };
   /** The force image the sampler was set up for: its address, modification
    * times (of the image and of its buffer) and buffered region; a
    * continuation of the same run keeps the sampler. */

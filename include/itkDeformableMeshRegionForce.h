@@ -518,7 +518,7 @@ public:
       int exponent = 0;
       return std::frexp(v, &exponent) == 0.5;
     };
-    const bool byInverse = powerOfTwo(dx) && powerOfTwo(dy) && powerOfTwo(dz);
+    const bool   byInverse = powerOfTwo(dx) && powerOfTwo(dy) && powerOfTwo(dz);
     const double inverseX = 1.0 / dx;
     const double inverseY = 1.0 / dy;
     const double inverseZ = 1.0 / dz;

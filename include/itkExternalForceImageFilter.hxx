@@ -245,11 +245,11 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::ComputeForceField(const Inp
   // there is one. With the normalisation, in the same pass as the scaling.
   constexpr bool ieeeComponents = std::is_same_v<ComponentType, float> || std::is_same_v<ComponentType, double>;
   using Bits = std::conditional_t<std::is_same_v<ComponentType, double>, uint64_t, uint32_t>;
-  constexpr Bits        magnitudeMask = ~(Bits{ 1 } << (8 * sizeof(Bits) - 1));
-  Bits                  largestBits = 0;
-  ComponentType *       components = n > 0 ? f[0].GetDataPointer() : nullptr;
-  const SizeValueType   numberOfComponents = n * OutputPixelType::Dimension;
-  const auto            scanComponents = [&]() {
+  constexpr Bits      magnitudeMask = ~(Bits{ 1 } << (8 * sizeof(Bits) - 1));
+  Bits                largestBits = 0;
+  ComponentType *     components = n > 0 ? f[0].GetDataPointer() : nullptr;
+  const SizeValueType numberOfComponents = n * OutputPixelType::Dimension;
+  const auto          scanComponents = [&]() {
     if constexpr (ieeeComponents)
     {
       for (SizeValueType i = 0; i < numberOfComponents; ++i)
@@ -532,9 +532,9 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::ForEachCentralDifference(co
     numberOfLines,
     [&](SizeValueType line) {
       // Zero-flux (Neumann) border, as GradientImageFilter's default.
-      OffsetValueType       lower[ImageDimension];
-      OffsetValueType       upper[ImageDimension];
-      const OffsetValueType lineStart = LocateLine(line, size, stride, lower, upper);
+      OffsetValueType         lower[ImageDimension];
+      OffsetValueType         upper[ImageDimension];
+      const OffsetValueType   lineStart = LocateLine(line, size, stride, lower, upper);
       constexpr SizeValueType blockLength = CentralDifferenceBlockLength;
       double                  derivative[ImageDimension * blockLength];
       for (SizeValueType x0 = 0; x0 < lineLength; x0 += blockLength)
@@ -561,10 +561,10 @@ ExternalForceImageFilter<TInputImage, TOutputImage>::ForEachCentralDifference(co
         }
         for (unsigned int d = 1; d < ImageDimension; ++d)
         {
-          const float *         below = p + lower[d];
-          const float *         above = p + upper[d];
-          double *              out = derivative + d * blockLength;
-          const double          s = scale[d];
+          const float * below = p + lower[d];
+          const float * above = p + upper[d];
+          double *      out = derivative + d * blockLength;
+          const double  s = scale[d];
           for (SizeValueType k = 0; k < count; ++k)
           {
             out[k] = (static_cast<double>(above[k]) - below[k]) * s;

@@ -312,7 +312,8 @@ RemoveLoops(Contours & contours)
       // then points m + 1 .. n - 1, 0 .. k.
       const size_t        n = c.points.size();
       std::vector<Point2> a{ where };
-      a.insert(a.end(), c.points.begin() + static_cast<std::ptrdiff_t>(k + 1),
+      a.insert(a.end(),
+               c.points.begin() + static_cast<std::ptrdiff_t>(k + 1),
                c.points.begin() + static_cast<std::ptrdiff_t>(m + 1));
       std::vector<Point2> b{ where };
       b.insert(b.end(), c.points.begin() + static_cast<std::ptrdiff_t>(m + 1), c.points.end());
@@ -1218,9 +1219,9 @@ DeformContours(const Image2DType *     image,
   // (RemoveLoops) and is resampled, and the level starts again from it; so
   // does the capture level when its longest edge exceeds
   // ContourCaptureStretch times the initial mean edge.
-  const bool   watch = !open && (schedule.regionWeight > 0.0 || o.balloon != 0.0);
-  const double initialMeanEdge = MeanEdgeLength(initial);
-  unsigned int restarts = 0;
+  const bool         watch = !open && (schedule.regionWeight > 0.0 || o.balloon != 0.0);
+  const double       initialMeanEdge = MeanEdgeLength(initial);
+  unsigned int       restarts = 0;
   itk::SizeValueType stageIterationsBefore = 0; // of the current stage, before its restarts
   for (unsigned int stage = 0;;)
   {
@@ -1258,25 +1259,25 @@ DeformContours(const Image2DType *     image,
       // level its own.
       const double spacing = capture ? std::min(MeanEdgeLength(current), 2.0 * initialMeanEdge) : stageMeanEdge;
       repaired = Resample(current, spacing);
-      progress.Note("contour " + std::string(loops > 0 ? "crossed itself: " + std::to_string(loops) + " loop(s) removed, "
-                                                       : "stretched: ") +
-                    "resampled to " + std::to_string(CountPoints(repaired)) + " points");
+      progress.Note(
+        "contour " +
+        std::string(loops > 0 ? "crossed itself: " + std::to_string(loops) + " loop(s) removed, " : "stretched: ") +
+        "resampled to " + std::to_string(CountPoints(repaired)) + " points");
       return true;
     };
     const bool checked = watch && restarts < defaults::ContourMaximumRestarts;
-    const bool restart =
-      RunLevel(deform.GetPointer(),
-               o,
-               schedule,
-               progress,
-               CountPoints(stageInput),
-               state,
-               snapshot ? std::function<void(itk::SizeValueType)>([&](itk::SizeValueType iteration) {
-                 snapshot(FromMesh(deform->GetOutput(), stageInput), iteration);
-               })
-                        : std::function<void(itk::SizeValueType)>(),
-               checked ? defaults::ContourCheckInterval : 0,
-               std::function<bool()>(checkpoint));
+    const bool restart = RunLevel(deform.GetPointer(),
+                                  o,
+                                  schedule,
+                                  progress,
+                                  CountPoints(stageInput),
+                                  state,
+                                  snapshot ? std::function<void(itk::SizeValueType)>([&](itk::SizeValueType iteration) {
+                                    snapshot(FromMesh(deform->GetOutput(), stageInput), iteration);
+                                  })
+                                           : std::function<void(itk::SizeValueType)>(),
+                                  checked ? defaults::ContourCheckInterval : 0,
+                                  std::function<bool()>(checkpoint));
     result.iterations = state.iterations;
     result.converged = state.converged;
     result.lastMaximumDisplacement = state.lastMaximumDisplacement;
@@ -1296,7 +1297,7 @@ DeformContours(const Image2DType *     image,
       // checked level's last checkpoint saw its output).
       RemoveLoops(output);
     }
-    const bool     fine = !(MeanEdgeLength(output) > 1.5 * schedule.edgeLength) ||
+    const bool fine = !(MeanEdgeLength(output) > 1.5 * schedule.edgeLength) ||
                       2.0 * static_cast<double>(CountPoints(output)) > maximumPoints;
     if (last || (ran > 0 && fine))
     {

@@ -183,9 +183,8 @@ ComputeForceField(const typename TForceFilter::InputImageType * image,
   if (progress.IsEnabled())
   {
     progress.Finish("sigma " + Format(sigma) + " mm" + (o.gradientVectorFlow ? ", gradient vector flow" : "") +
-                  (o.normalizeForces ? ", normalised" : ", not normalised") + " (" +
-                    Format(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2) +
-                    " s)");
+                    (o.normalizeForces ? ", normalised" : ", not normalised") + " (" +
+                    Format(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2) + " s)");
   }
   typename TForceFilter::OutputImageType::Pointer field = force->GetOutput();
   field->DisconnectPipeline();
@@ -351,8 +350,8 @@ RunLevel(TFilter *                                       deform,
          const std::function<bool()> &                   checkpoint = std::function<bool()>())
 {
   const itk::SizeValueType cap = deform->GetNumberOfIterations();
-  const std::string level = std::to_string(numberOfPoints) + " points";
-  const auto        iterationsBefore = state.iterations;
+  const std::string        level = std::to_string(numberOfPoints) + " points";
+  const auto               iterationsBefore = state.iterations;
   progress.Start("deforming");
   const auto start = std::chrono::steady_clock::now();
   // Only a progress that draws observes the filter: an observer of
@@ -464,7 +463,7 @@ RunLevel(TFilter *                                       deform,
           " " + s.pointsWord + " moving" + (s.convergenceAlongNormals ? " along their normals" : "") + " by "
       : std::string(s.convergenceAlongNormals ? "largest step along the normals below " : "largest step below ");
   progress.Finish(std::to_string(deform->GetCurrentIteration()) + " iterations on " + level + ", " +
-                  (stopped            ? std::string("stopped to repair the contour")
+                  (stopped           ? std::string("stopped to repair the contour")
                    : state.converged ? "converged (" + quiet + Format(deform->GetConvergenceTolerance()) + " mm for " +
                                          std::to_string(o.convergenceWindow) + " iterations)"
                                      : std::string("iteration cap reached")) +

@@ -311,15 +311,15 @@ void
 WriteEllipse2D(const std::string & path, const std::map<std::string, std::string> & options)
 {
   using ImageType = itk::Image<TPixel, VDimension>;
-  const auto                      size = Numbers(options, "--size", 2);
-  const auto                      spacing = Numbers(options, "--spacing", 2);
-  const auto                      origin = Numbers(options, "--origin", 2);
-  const auto                      c = Numbers(options, "--center", 2);
-  const auto                      r = Numbers(options, "--radii", 2);
-  const double                    angle = options.count("--angle") ? std::stod(options.at("--angle")) : 0.0;
-  const double                    inside = options.count("--inside") ? std::stod(options.at("--inside")) : 200.0;
-  const double                    outside = options.count("--outside") ? std::stod(options.at("--outside")) : 40.0;
-  std::vector<double>             holes;
+  const auto          size = Numbers(options, "--size", 2);
+  const auto          spacing = Numbers(options, "--spacing", 2);
+  const auto          origin = Numbers(options, "--origin", 2);
+  const auto          c = Numbers(options, "--center", 2);
+  const auto          r = Numbers(options, "--radii", 2);
+  const double        angle = options.count("--angle") ? std::stod(options.at("--angle")) : 0.0;
+  const double        inside = options.count("--inside") ? std::stod(options.at("--inside")) : 200.0;
+  const double        outside = options.count("--outside") ? std::stod(options.at("--outside")) : 40.0;
+  std::vector<double> holes;
   if (options.count("--holes"))
   {
     std::stringstream list(options.at("--holes"));
@@ -483,10 +483,10 @@ MeasureContour(const std::string & path, const std::map<std::string, std::string
   // all pairs, independently of edmodel's own test.
   const size_t n = points.size();
   size_t       crossings = 0;
-  const auto   cross = [](const std::array<double, 2> & o, const std::array<double, 2> & a,
-                        const std::array<double, 2> & b) {
-    return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
-  };
+  const auto   cross =
+    [](const std::array<double, 2> & o, const std::array<double, 2> & a, const std::array<double, 2> & b) {
+      return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+    };
   for (size_t k = 0; k < n && n >= 4; ++k)
   {
     for (size_t m = k + 2; m < n; ++m)
@@ -503,7 +503,8 @@ MeasureContour(const std::string & path, const std::map<std::string, std::string
       const double d2 = cross(a, b, q);
       const double d3 = cross(p, q, a);
       const double d4 = cross(p, q, b);
-      if (((d1 <= 0.0 && d2 >= 0.0) || (d1 >= 0.0 && d2 <= 0.0)) && ((d3 <= 0.0 && d4 >= 0.0) || (d3 >= 0.0 && d4 <= 0.0)))
+      if (((d1 <= 0.0 && d2 >= 0.0) || (d1 >= 0.0 && d2 <= 0.0)) &&
+          ((d3 <= 0.0 && d4 >= 0.0) || (d3 >= 0.0 && d4 <= 0.0)))
       {
         ++crossings;
       }
@@ -516,7 +517,7 @@ MeasureContour(const std::string & path, const std::map<std::string, std::string
             << maximum << " mm (limits " << maxMean << ", " << maxMax << "); " << crossings
             << " pair(s) of crossing edges" << std::endl;
   return mean <= maxMean && maximum <= maxMax && points.size() >= minPoints && crossings == 0 ? EXIT_SUCCESS
-                                                                                               : EXIT_FAILURE;
+                                                                                              : EXIT_FAILURE;
 }
 
 int
