@@ -518,7 +518,7 @@ public:
       int exponent = 0;
       return std::frexp(v, &exponent) == 0.5;
     };
-    const bool   byInverse = powerOfTwo(dx) && powerOfTwo(dy) && powerOfTwo(dz);
+    const bool   powersOfTwo = powerOfTwo(dx) && powerOfTwo(dy) && powerOfTwo(dz);
     const double inverseX = 1.0 / dx;
     const double inverseY = 1.0 / dy;
     const double inverseZ = 1.0 / dz;
@@ -528,17 +528,24 @@ public:
     // floats), without a square root per voxel.
     std::vector<double> values(count / stride + 1);
     size_t              n = 0;
-    const auto          squaredMagnitude = [&](size_t offset) {
-      const double gx = (buffer[offset + sx] - buffer[offset - sx]) / dx;
-      const double gy = (buffer[offset + sy] - buffer[offset - sy]) / dy;
+    // byInverse: std::true_type multiplies by the inverses (power-of-two
+    // spacings), std::false_type divides.
+    const auto squaredMagnitude = [&](size_t offset, auto byInverse) {
+      const auto derivative = [&](size_t step, double twoSpacings, double inverse) {
+        const double difference = buffer[offset + step] - buffer[offset - step];
+        if constexpr (decltype(byInverse)::value)
+        {
+          return difference * inverse;
+        }
+        else
+        {
+          return difference / twoSpacings;
+        }
+      };
+      const double gx = derivative(sx, dx, inverseX);
+      const double gy = derivative(sy, dy, inverseY);
       // One slice (a 2-D image embedded in 3-D): no z gradient.
-      const double gz = flat ? 0.0 : (buffer[offset + sz] - buffer[offset - sz]) / dz;
-      return gx * gx + gy * gy + gz * gz;
-    };
-    const auto squaredMagnitudeByInverse = [&](size_t offset) {
-      const double gx = (buffer[offset + sx] - buffer[offset - sx]) * inverseX;
-      const double gy = (buffer[offset + sy] - buffer[offset - sy]) * inverseY;
-      const double gz = flat ? 0.0 : (buffer[offset + sz] - buffer[offset - sz]) * inverseZ;
+      const double gz = flat ? 0.0 : derivative(sz, dz, inverseZ);
       return gx * gx + gy * gy + gz * gz;
     };
     if (stride == 1)
@@ -546,28 +553,28 @@ public:
       // Every inner voxel, row by row (loops the compiler vectorises).
       const size_t firstK = flat ? 0 : 1;
       const size_t endK = flat ? 1 : (size[2] > 1 ? size[2] - 1 : 0);
-      for (size_t k = firstK; k < endK; ++k)
-      {
-        for (size_t j = 1; j + 1 < size[1]; ++j)
+      const auto   fillRows = [&](auto byInverse) {
+        for (size_t k = firstK; k < endK; ++k)
         {
-          const size_t row = k * sz + j * sy;
-          double *     out = values.data() + n;
-          if (byInverse)
+          for (size_t j = 1; j + 1 < size[1]; ++j)
           {
+            const size_t row = k * sz + j * sy;
+            double *     out = values.data() + n;
             for (size_t i = 1; i + 1 < size[0]; ++i)
             {
-              out[i - 1] = squaredMagnitudeByInverse(row + i);
+              out[i - 1] = squaredMagnitude(row + i, byInverse);
             }
+            n += size[0] > 2 ? size[0] - 2 : 0;
           }
-          else
-          {
-            for (size_t i = 1; i + 1 < size[0]; ++i)
-            {
-              out[i - 1] = squaredMagnitude(row + i);
-            }
-          }
-          n += size[0] > 2 ? size[0] - 2 : 0;
         }
+      };
+      if (powersOfTwo)
+      {
+        fillRows(std::true_type{});
+      }
+      else
+      {
+        fillRows(std::false_type{});
       }
     }
     else
@@ -596,7 +603,7 @@ public:
         {
           continue;
         }
-        values[n++] = squaredMagnitude(offset);
+        values[n++] = squaredMagnitude(offset, std::false_type{});
       }
     }
     values.resize(n);
