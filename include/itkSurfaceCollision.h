@@ -30,6 +30,9 @@
 #include <limits>
 #include <utility>
 #include <vector>
+#if defined(__SSE2__)
+#  include <emmintrin.h>
+#endif
 
 namespace itk
 {
@@ -681,6 +684,64 @@ SeparatedBy(const double * const * a, const double * const * b, double d)
   return false;
 }
 
+/** Writes to \a hits the indices j in [first, last) of the spheres whose
+ * float centres (x, y, z: structure of arrays) lie closer to (px, py, pz)
+ * than reach + r[j], and returns their number: a filter before an exact
+ * test, so the caller widens \a reach by the floats' rounding. The arrays
+ * must be readable 3 entries beyond \a last. SSE2 four spheres at a time
+ * (about one in seven passes, so the indices are written without a
+ * branch). */
+inline SizeValueType
+SpheresWithin(const float * x,
+              const float * y,
+              const float * z,
+              const float * r,
+              uint32_t      first,
+              uint32_t      last,
+              float         px,
+              float         py,
+              float         pz,
+              float         reach,
+              uint32_t *    hits)
+{
+  SizeValueType count = 0;
+#if defined(__SSE2__)
+  const __m128 vx = _mm_set1_ps(px);
+  const __m128 vy = _mm_set1_ps(py);
+  const __m128 vz = _mm_set1_ps(pz);
+  const __m128 vr = _mm_set1_ps(reach);
+  for (uint32_t j = first; j < last; j += 4)
+  {
+    const __m128 dx = _mm_sub_ps(_mm_loadu_ps(x + j), vx);
+    const __m128 dy = _mm_sub_ps(_mm_loadu_ps(y + j), vy);
+    const __m128 dz = _mm_sub_ps(_mm_loadu_ps(z + j), vz);
+    const __m128 sum = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    const __m128 limit = _mm_add_ps(_mm_loadu_ps(r + j), vr);
+    unsigned int mask = static_cast<unsigned int>(_mm_movemask_ps(_mm_cmplt_ps(sum, _mm_mul_ps(limit, limit))));
+    if (last - j < 4)
+    {
+      mask &= (1u << (last - j)) - 1u;
+    }
+    for (unsigned int b = 0; b < 4; ++b)
+    {
+      hits[count] = j + b;
+      count += (mask >> b) & 1u;
+    }
+  }
+#else
+  for (uint32_t j = first; j < last; ++j)
+  {
+    const float dx = x[j] - px;
+    const float dy = y[j] - py;
+    const float dz = z[j] - pz;
+    const float limit = r[j] + reach;
+    hits[count] = j;
+    count += dx * dx + dy * dy + dz * dz < limit * limit ? 1 : 0;
+  }
+#endif
+  return count;
+}
+
 /** Triangles t and u (3 vertex indices each) share a vertex. */
 inline bool
 ShareVertex(const uint32_t * t, const uint32_t * u)
@@ -994,6 +1055,23 @@ NextFloatUp(float f)
   return -NextFloatDown(-f);
 }
 
+/** A float not above m and one not below it, without a branch (the
+ * per-point rounding of a step of the index; RoundDown() and RoundUp() are
+ * tighter by up to two units in the last place and branch on every value).
+ * m is clamped to the finite floats first; the nearest float f of m is
+ * within half a unit in the last place of it, and |f| 2^-23 is at least one
+ * unit, so f - |f| 2^-23 (rounded to nearest) is below m; 1e-30 covers
+ * zero and the subnormals. m must not be NaN. */
+inline void
+OutwardFloats(double low, double high, float & below, float & above)
+{
+  constexpr double largest = std::numeric_limits<float>::max();
+  const auto       lo = static_cast<float>(std::min(std::max(low, -largest), largest));
+  const auto       hi = static_cast<float>(std::min(std::max(high, -largest), largest));
+  below = lo - (std::abs(lo) * 0x1p-23f + 1e-30f);
+  above = hi + (std::abs(hi) * 0x1p-23f + 1e-30f);
+}
+
 /** Writes the float box of the points (3 doubles each) given, widened by
  * \a margin and rounded outward. */
 inline void
@@ -1186,6 +1264,16 @@ public:
     }
     const SizeValueType numberOfSharedPairs = m_SharedPairs.size() / 2;
     GroupsOfKeys(m_SharedPairs, 2, numberOfTriangles, m_SharedOffsets, m_SharedOfTriangle);
+    // The other triangle of each entry, read at every step without a visit
+    // to the pair.
+    m_SharedPartner.resize(m_SharedOfTriangle.size());
+    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+    {
+      for (IndexType k = m_SharedOffsets[t]; k < m_SharedOffsets[t + 1]; ++k)
+      {
+        m_SharedPartner[k] = this->OtherOfShared(m_SharedOfTriangle[k], t);
+      }
+    }
     m_SharedGaps.assign(numberOfSharedPairs, 0.0f);
     m_SharedExact.assign(numberOfSharedPairs, 0);
     m_SharedComputed.assign(numberOfSharedPairs, 0.0f);
@@ -1408,7 +1496,7 @@ public:
           for (IndexType k = m_SharedOffsets[t]; k < m_SharedOffsets[t + 1]; ++k)
           {
             const IndexType q = m_SharedOfTriangle[k];
-            const IndexType u = this->OtherOfShared(q, t);
+            const IndexType u = m_SharedPartner[k];
             if (m_Active[u] && u < t)
             {
               continue;
@@ -1458,7 +1546,7 @@ public:
           for (IndexType k = m_SharedOffsets[t]; k < m_SharedOffsets[t + 1]; ++k)
           {
             const IndexType q = m_SharedOfTriangle[k];
-            const IndexType u = this->OtherOfShared(q, t);
+            const IndexType u = m_SharedPartner[k];
             if ((m_IsLarge[u] && u < t) ||
                 this->SharedPairClear(q, LargestDistance(bt, m_TriangleDelta.data() + 6 * u)))
             {
@@ -1906,6 +1994,20 @@ private:
     {
       box[k] = std::min(box[k], other[k]);
       box[3 + k] = std::max(box[3 + k], other[3 + k]);
+    }
+  }
+
+  /** The box of triangle v's vertex boxes (m_VertexDelta) in \a box. */
+  void
+  TriangleOfVertexBoxes(const IndexType * v, float * box) const
+  {
+    const float * a = m_VertexDelta.data() + 6 * v[0];
+    const float * b = m_VertexDelta.data() + 6 * v[1];
+    const float * c = m_VertexDelta.data() + 6 * v[2];
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      box[k] = std::min(a[k], std::min(b[k], c[k]));
+      box[3 + k] = std::max(a[3 + k], std::max(b[3 + k], c[3 + k]));
     }
   }
 
@@ -2431,8 +2533,17 @@ private:
     };
     // The triangles' spheres, vertices, corners and boxes copied in cell
     // order, so that the pairs of two cells read them in sequence.
-    const SizeValueType    celled = m_CellOrder.size();
-    std::vector<double>    cellSpheres(4 * celled);
+    const SizeValueType celled = m_CellOrder.size();
+    std::vector<double> cellSpheres(4 * celled);
+    // The spheres again as floats, one array per coordinate (4 entries of
+    // padding: SpheresWithin() reads up to 3 beyond a cell's end), for the
+    // filter before the double test; the reach is widened by the floats'
+    // rounding (relative 2^-24 on each coordinate and radius, and on each
+    // operation: 1e-6 of the largest magnitude covers it).
+    std::vector<float>     cellX(celled + 4, 0.0f);
+    std::vector<float>     cellY(celled + 4, 0.0f);
+    std::vector<float>     cellZ(celled + 4, 0.0f);
+    std::vector<float>     cellR(celled + 4, 0.0f);
     std::vector<IndexType> cellTriangles(3 * celled);
     std::vector<double>    cellCorners(9 * celled);
     std::vector<float>     cellBoxes(6 * celled);
@@ -2442,6 +2553,10 @@ private:
         const IndexType   t = m_CellOrder[i];
         const IndexType * v = m_Triangles.data() + 3 * t;
         std::copy_n(m_Spheres.data() + 4 * t, 4, cellSpheres.data() + 4 * i);
+        cellX[i] = static_cast<float>(m_Spheres[4 * t]);
+        cellY[i] = static_cast<float>(m_Spheres[4 * t + 1]);
+        cellZ[i] = static_cast<float>(m_Spheres[4 * t + 2]);
+        cellR[i] = static_cast<float>(m_Spheres[4 * t + 3]);
         std::copy_n(v, 3, cellTriangles.data() + 3 * i);
         for (unsigned int k = 0; k < 3; ++k)
         {
@@ -2491,6 +2606,13 @@ private:
       }
       out.push_back({ static_cast<IndexType>(t), static_cast<IndexType>(u), RoundDown(std::max(gap, 0.0)) });
     };
+    double largestMagnitude = 0.0;
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      largestMagnitude = std::max({ largestMagnitude, std::abs(lower[k]), std::abs(upper[k]) });
+    }
+    const auto floatReach =
+      static_cast<float>(radius + 1e-6 * (largestMagnitude + radius + 2.0 * typicalRadius + 1.0)) * (1.0f + 1e-6f);
     const CellLevel &              base = m_Levels[0];
     const SizeValueType            baseCells = base.keys.size();
     const SizeValueType            cellBlocks = (baseCells + 1023) / 1024;
@@ -2513,24 +2635,34 @@ private:
             const double *  si = cellSpheres.data() + 4 * i;
             const double    reachOfI = radius + si[3];
             const IndexType first = other == s ? i + 1 : m_CellOffsets[other];
-            // The pairs whose spheres come within R, listed without a branch
-            // (about one in seven passes: the branch was mispredicted).
-            hits.resize(std::max<SizeValueType>(hits.size(), last - std::min(first, last)));
-            SizeValueType count = 0;
-            for (IndexType j = first; j < last; ++j)
-            {
-              const double * sj = cellSpheres.data() + 4 * j;
-              const double   e0 = si[0] - sj[0];
-              const double   e1 = si[1] - sj[1];
-              const double   e2 = si[2] - sj[2];
-              const double   reach = reachOfI + sj[3];
-              hits[count] = j;
-              count += e0 * e0 + e1 * e1 + e2 * e2 < reach * reach * (1.0 + 1e-12) ? 1 : 0;
-            }
+            // The pairs whose spheres come within R: the float filter, then
+            // the double test on its hits (about one in seven passes).
+            hits.resize(std::max<SizeValueType>(hits.size(), last - std::min(first, last) + 4));
+            const SizeValueType count = SurfaceCollisionDetail::SpheresWithin(cellX.data(),
+                                                                              cellY.data(),
+                                                                              cellZ.data(),
+                                                                              cellR.data(),
+                                                                              first,
+                                                                              last,
+                                                                              cellX[i],
+                                                                              cellY[i],
+                                                                              cellZ[i],
+                                                                              floatReach + cellR[i],
+                                                                              hits.data());
             for (SizeValueType h = 0; h < count; ++h)
             {
               const IndexType j = hits[h];
               const double *  sj = cellSpheres.data() + 4 * j;
+              {
+                const double e0 = si[0] - sj[0];
+                const double e1 = si[1] - sj[1];
+                const double e2 = si[2] - sj[2];
+                const double reach = reachOfI + sj[3];
+                if (!(e0 * e0 + e1 * e1 + e2 * e2 < reach * reach * (1.0 + 1e-12)))
+                {
+                  continue;
+                }
+              }
               // A shared vertex (half of the pairs whose spheres come
               // within R): no candidate.
               if (SurfaceCollisionDetail::ShareVertex(cellTriangles.data() + 3 * i, cellTriangles.data() + 3 * j))
@@ -2815,7 +2947,8 @@ private:
     const double        d = std::max(m_MinimumDistance, m_ContactDistance);
     std::atomic<bool>   finite{ true };
     parallel(n, [&](SizeValueType begin, SizeValueType end) {
-      bool blockFinite = true;
+      // v - v is 0 for a finite v and NaN otherwise: one test per block.
+      double check = 0.0;
       for (SizeValueType i = begin; i < end; ++i)
       {
         float * box = m_VertexDelta.data() + 6 * i;
@@ -2830,12 +2963,11 @@ private:
             low = std::min(delta, other);
             delta = std::max(delta, other);
           }
-          blockFinite = blockFinite && std::isfinite(delta) && std::isfinite(low);
-          box[k] = RoundDown(low);
-          box[3 + k] = RoundUp(delta);
+          check += (delta - delta) + (low - low);
+          SurfaceCollisionDetail::OutwardFloats(low, delta, box[k], box[3 + k]);
         }
       }
-      if (!blockFinite)
+      if (!(check == 0.0))
       {
         finite = false;
       }
@@ -2857,9 +2989,7 @@ private:
           const IndexType   t = m_CellOrder[i];
           const IndexType * v = m_Triangles.data() + 3 * t;
           float *           box = m_TriangleDelta.data() + 6 * t;
-          std::copy(m_VertexDelta.data() + 6 * v[0], m_VertexDelta.data() + 6 * v[0] + 6, box);
-          Unite(box, m_VertexDelta.data() + 6 * v[1]);
-          Unite(box, m_VertexDelta.data() + 6 * v[2]);
+          TriangleOfVertexBoxes(v, box);
           Unite(cellBox, box);
         }
       }
@@ -3019,6 +3149,7 @@ private:
   std::vector<IndexType>     m_SharedPairs;      // pairs sharing exactly one vertex: t, u (t < u)
   std::vector<IndexType>     m_SharedOffsets;    // triangle -> range of m_SharedOfTriangle
   std::vector<IndexType>     m_SharedOfTriangle; // the shared pairs each triangle is in
+  std::vector<IndexType>     m_SharedPartner;    // per entry of m_SharedOfTriangle, the other triangle
   std::vector<float>         m_SharedGaps;       // per shared pair: a lower bound of its gap at the reference
   std::vector<uint8_t>       m_SharedExact;      // per shared pair: the bound is the exact gap
   std::vector<float>         m_SharedComputed;   // per shared pair: its bound when last computed (not carried)
