@@ -1170,10 +1170,22 @@ StoreBox(const double * lower, const double * upper, double margin, float * box)
  *   rho_t between t's box and the neighbourhood box of its cell is below
  *   d(t, u) - d: below R - d for the pairs that are not candidates, below
  *   the clearance of t for all of them.
- * When a level's bound or some rho_t reaches R - d the index is rebuilt at
- * the proposed positions y (where every displacement is zero, so that every
- * bound holds); a pair that violates the constraint at y is then closer
- * than d at the reference, within its triangles' clearance, and tested.
+ * A triangle whose rho_t reaches R - d is deferred: besides its
+ * candidates, it queries at that step a grid of the boxes at the reference
+ * for every triangle within d plus its motion against the 27 cells around
+ * its own. Level 1's test, when it fails for a cell, is redone per pair of
+ * level-0 cells within 3 cells of each other along each axis (with their
+ * own separation, radii and boxes: their centroids are at least h
+ * sqrt(sum_k max(0, |D_k| - 1)^2) apart for coordinates differing by D_k),
+ * and the triangles of the level-0 cells it does not clear are deferred
+ * (their motion taken against the 27 level-1 cells around their parent).
+ * On a converging surface a few triangles moving against the rest made
+ * most rebuilds. When a level above 1 fails, or more than 1/64 of the
+ * triangles are deferred at one step or 1/4 summed over the steps since
+ * the rebuild, the index is rebuilt at the proposed positions y (where
+ * every displacement is zero, so that every bound holds); a pair that
+ * violates the constraint at y is then closer than d at the reference,
+ * within its triangles' clearance, and tested.
  * Only the triangles whose rho_t reaches their clearance ("tested
  * triangles") have their candidate pairs looked at, each first against the
  * pair's own bound (the largest distance between the two triangles' boxes
@@ -1358,6 +1370,16 @@ public:
     return m_Large.size();
   }
 
+  /** The triangles deferred at the last Constrain() (their motion against
+   * their neighbourhood reached what the index bounds, so they queried the
+   * grid of the boxes at the reference instead of the index being
+   * rebuilt), for diagnostics. */
+  SizeValueType
+  GetNumberOfDeferredTriangles() const
+  {
+    return m_NumberOfDeferredTriangles;
+  }
+
   /** The points whose displacement the last Constrain() reduced. */
   const std::vector<IndexType> &
   GetConstrainedPoints() const
@@ -1447,6 +1469,7 @@ public:
       }
       bounded = status == BoundStatus::Bounded;
     }
+    m_NumberOfDeferredTriangles = bounded ? m_Deferred.size() : 0;
     const double d = std::max(minimumDistance, m_ContactDistance);
 
     std::vector<std::pair<IndexType, IndexType>> violating;
@@ -1610,6 +1633,51 @@ public:
         }
       });
       for (const auto & block : largeFound)
+      {
+        violating.insert(violating.end(), block.begin(), block.end());
+      }
+      // The deferred triangles (rho reached R - d, Bound()): their
+      // candidates and shared pairs were tested above (they are active);
+      // their other pairs were at least R apart at the reference and move
+      // by at most the largest distance between t's displacement box and
+      // the box of all displacements (at least rho), so every triangle
+      // whose box at the reference comes within d plus that motion.
+      m_NumberOfTestedTriangles += m_Deferred.size();
+      if (!m_Deferred.empty())
+      {
+        this->EnsureReferenceGrid();
+      }
+      const SizeValueType                                       deferredBlocks = (m_Deferred.size() + 63) / 64;
+      std::vector<std::vector<std::pair<IndexType, IndexType>>> deferredFound(deferredBlocks);
+      const auto                                                deferredParallel = [&](auto && body) {
+        if (deferredBlocks < 2 || threader == nullptr || workUnits < 2)
+        {
+          for (SizeValueType b = 0; b < deferredBlocks; ++b)
+          {
+            body(b);
+          }
+        }
+        else
+        {
+          threader->SetNumberOfWorkUnits(workUnits);
+          threader->ParallelizeArray(0, deferredBlocks, body, nullptr);
+        }
+      };
+      deferredParallel([&](SizeValueType b) {
+        auto & out = deferredFound[b];
+        for (SizeValueType l = 64 * b; l < std::min<SizeValueType>(m_Deferred.size(), 64 * (b + 1)); ++l)
+        {
+          const IndexType t = m_Deferred[l];
+          this->ForEachGridPartner(t, this->DeferredMotion(t), d, [&](SizeValueType u) {
+            if (this->Violates(t, u, x, y, d))
+            {
+              out.emplace_back(static_cast<IndexType>(std::min<SizeValueType>(t, u)),
+                               static_cast<IndexType>(std::max<SizeValueType>(t, u)));
+            }
+          });
+        }
+      });
+      for (const auto & block : deferredFound)
       {
         violating.insert(violating.end(), block.begin(), block.end());
       }
@@ -1866,6 +1934,14 @@ private:
    * many R since it was computed. */
   static constexpr double SharedLoss = 0.25;
 
+  /** Deferred triangles (Bound()) are tolerated up to 1/DeferredPerStep of
+   * the triangles (at least 64) at one step and 1/DeferredPerRebuild (at
+   * least 1024) summed over the steps since the rebuild; beyond, the index
+   * is rebuilt (a deferred triangle's grid query costs about what a
+   * rebuild costs per triangle). */
+  static constexpr SizeValueType DeferredPerStep = 64;
+  static constexpr SizeValueType DeferredPerRebuild = 4;
+
   enum class BoundStatus
   {
     Bounded,
@@ -1882,6 +1958,8 @@ private:
     double                 cellSize{ 1.0 };
     std::vector<uint64_t>  keys;
     std::vector<IndexType> parents;
+    std::vector<IndexType> childOffsets; // the finer level's cells in each cell (levels >= 1)
+    std::vector<IndexType> children;
     std::vector<IndexType> neighbourOffsets;
     std::vector<IndexType> neighbours;
     std::vector<double>    radii;          // largest triangle radius in the cell
@@ -2069,23 +2147,70 @@ private:
       }
       f(u);
     }
-    // The pairs with a large triangle that are no candidates were at least
-    // R apart at the reference: clear while t's motion against every
-    // displacement stays below R - d.
-    const double globalMotion = m_Large.empty() ? 0.0 : LargestDistance(bt, m_GlobalDelta);
-    if (m_Large.empty() || globalMotion < m_Radius - d)
+    // The pairs with a large or deferred triangle that are no candidates
+    // were at least R apart at the reference: clear while t's motion
+    // against every displacement stays below R - d (the other pairs are
+    // bounded by the triangles' rho).
+    if (m_Large.empty() && m_Deferred.empty())
     {
       return;
     }
-    const double reach = globalMotion + d;
-    double       lo[3], hi[3];
+    const double globalMotion = LargestDistance(bt, m_GlobalDelta);
+    if (globalMotion < m_Radius - d)
+    {
+      return;
+    }
+    this->EnsureReferenceGrid();
+    this->ForEachGridPartner(t, globalMotion, d, [&](SizeValueType u) {
+      if (m_IsLarge[t] || m_IsLarge[u] || m_IsDeferred[t] || m_IsDeferred[u])
+      {
+        f(u);
+      }
+    });
+  }
+
+  /** A bound of the motion of deferred triangle t against every triangle
+   * of the cells whose pairs with t the levels of the pyramid do not bound
+   * (Bound()): the union of the 27 level-0 cells around its own when only
+   * its rho failed, of the 27 level-1 cells around its parent when level 1
+   * did not clear its cell. */
+  double
+  DeferredMotion(SizeValueType t) const
+  {
+    const float *   bt = m_TriangleDelta.data() + 6 * t;
+    const IndexType s = m_TriangleCell[t];
+    if (m_Levels.size() > 1 && m_CellDeferred[s])
+    {
+      return LargestDistance(bt, m_Levels[1].unions.data() + 6 * m_Levels[0].parents[s]);
+    }
+    return LargestDistance(bt, m_Levels[0].unions.data() + 6 * s);
+  }
+
+  /** Calls f(u) for every triangle u sharing no vertex with t whose box at
+   * the reference comes within d + \a motion of t's and that the
+   * reference spheres and the pair's displacement boxes do not clear
+   * (\a motion bounds t's displacement against every other; the grid must
+   * be built, EnsureReferenceGrid()). */
+  template <typename TFunction>
+  void
+  ForEachGridPartner(SizeValueType t, double motion, double d, TFunction && f) const
+  {
+    const float * bt = m_TriangleDelta.data() + 6 * t;
+    double        lo[3], hi[3];
     TriangleBox(m_Reference.data(), m_Triangles.data() + 3 * t, lo, hi);
     float query[6];
-    SurfaceCollisionDetail::StoreBox(lo, hi, reach, query);
-    this->EnsureReferenceGrid();
+    SurfaceCollisionDetail::StoreBox(lo, hi, motion + d, query);
+    const double * st = m_Spheres.data() + 4 * t;
     m_ReferenceGrid.ForEachOverlapOfBox(query, t, [&](SizeValueType u) {
-      if ((!m_IsLarge[t] && !m_IsLarge[u]) ||
-          SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
+      if (SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
+      {
+        return;
+      }
+      const double * su = m_Spheres.data() + 4 * u;
+      double         e[3];
+      SurfaceCollisionDetail::Subtract(st, su, e);
+      const double gap = std::sqrt(SurfaceCollisionDetail::Dot(e, e)) - st[3] - su[3];
+      if (LargestDistance(bt, m_TriangleDelta.data() + 6 * u) < gap - d)
       {
         return;
       }
@@ -2889,6 +3014,10 @@ private:
       m_Levels.push_back(std::move(coarser));
       FindNeighbours(m_Levels.back());
     }
+    for (SizeValueType l = 1; l < m_Levels.size(); ++l)
+    {
+      GroupsOfKeys(m_Levels[l - 1].parents, 1, m_Levels[l].keys.size(), m_Levels[l].childOffsets, m_Levels[l].children);
+    }
     // The largest triangle radius of each cell and of the 27 around it.
     m_Levels[0].radii.assign(m_Levels[0].keys.size(), 0.0);
     for (const IndexType t : m_CellOrder)
@@ -2931,6 +3060,9 @@ private:
     m_VertexDelta.resize(6 * n);
     m_TriangleDelta.resize(6 * numberOfTriangles);
     m_Active.assign(numberOfTriangles, 0);
+    m_IsDeferred.assign(numberOfTriangles, 0);
+    m_Deferred.clear();
+    m_DeferredSum = 0;
     m_IndexValid = true;
     return true;
   }
@@ -2979,6 +3111,8 @@ private:
     // Triangles' and level-0 cells' boxes.
     CellLevel &         base = m_Levels[0];
     const SizeValueType baseCells = base.keys.size();
+    m_CellDeferred.assign(baseCells, 0);
+    m_CellDiameter.resize(baseCells);
     parallel(baseCells, [&](SizeValueType begin, SizeValueType end) {
       for (SizeValueType s = begin; s < end; ++s)
       {
@@ -2992,6 +3126,7 @@ private:
           TriangleOfVertexBoxes(v, box);
           Unite(cellBox, box);
         }
+        m_CellDiameter[s] = LargestDistance(cellBox, cellBox);
       }
     });
     // The large triangles' boxes, and the box of every displacement.
@@ -3038,7 +3173,16 @@ private:
           if (l > 0 && !(LargestDistance(level.boxes.data() + 6 * s, u) <
                          separation - (level.radii[s] + level.neighbourRadii[s]) * (1.0 + 1e-9) - d))
           {
-            out = true;
+            // Level 1 at the resolution of level 0: defers the triangles of
+            // the level-0 cells it does not clear. Above: a rebuild.
+            if (l == 1)
+            {
+              this->DeferLevelOneCell(s, d);
+            }
+            else
+            {
+              out = true;
+            }
           }
         }
         if (out)
@@ -3056,10 +3200,20 @@ private:
     {
       Unite(m_GlobalDelta, top.boxes.data() + 6 * c);
     }
-    // Level 0: rho of each triangle against its cell's neighbourhood.
-    const double radiusLimit = m_Radius - d;
+    // Level 0: rho of each triangle against its cell's neighbourhood. A
+    // triangle whose rho reaches R - d is deferred: its pairs that are no
+    // candidates may have come within d, so it queries the grid of the
+    // boxes at the reference, as the large triangles do (Constrain()),
+    // instead of the index being rebuilt for a few triangles that move
+    // against the rest (a converging surface). Too many of them, at this
+    // step or summed over the steps since the rebuild, and the index is
+    // rebuilt: each costs a grid query per step, a rebuild about as much
+    // per triangle.
+    const double                        radiusLimit = m_Radius - d;
+    const SizeValueType                 blocks = (baseCells + 1023) / 1024;
+    std::vector<std::vector<IndexType>> deferred(blocks);
     parallel(baseCells, [&](SizeValueType begin, SizeValueType end) {
-      bool out = false;
+      auto & out = deferred[begin / 1024];
       for (SizeValueType s = begin; s < end; ++s)
       {
         const float * u = base.unions.data() + 6 * s;
@@ -3072,19 +3226,168 @@ private:
           if (cellClear)
           {
             m_Active[t] = 0;
+            m_IsDeferred[t] = m_CellDeferred[s];
+            if (m_CellDeferred[s])
+            {
+              out.push_back(t);
+            }
             continue;
           }
           const double rho = LargestDistance(m_TriangleDelta.data() + 6 * t, u);
-          out = out || (!cellInside && !(rho < radiusLimit));
+          const bool   defer = m_CellDeferred[s] || (!cellInside && !(rho < radiusLimit) && this->DeferByRho(t, s, d));
+          m_IsDeferred[t] = defer ? 1 : 0;
+          if (defer)
+          {
+            out.push_back(t);
+          }
           m_Active[t] = rho < static_cast<double>(m_Clearance[t]) ? 0 : 1;
         }
       }
-      if (out)
-      {
-        exceeded = true;
-      }
     });
-    return exceeded ? BoundStatus::Exceeded : BoundStatus::Bounded;
+    m_Deferred.clear();
+    for (const auto & block : deferred)
+    {
+      m_Deferred.insert(m_Deferred.end(), block.begin(), block.end());
+    }
+    const SizeValueType numberOfTriangles = this->GetNumberOfTriangles();
+    if (x == nullptr)
+    {
+      m_DeferredSum += m_Deferred.size();
+    }
+    if (m_Deferred.size() > std::max<SizeValueType>(numberOfTriangles / DeferredPerStep, 64) ||
+        m_DeferredSum > std::max<SizeValueType>(numberOfTriangles / DeferredPerRebuild, 1024))
+    {
+      return BoundStatus::Exceeded;
+    }
+    return BoundStatus::Bounded;
+  }
+
+  /** Of two level-0 cells whose pairs of triangles are not bounded, the
+   * one whose triangles are deferred (so that each pair has one side that
+   * queries the grid, not both): the one whose displacement box is the
+   * larger (it moved against the other), the lower index on a tie. */
+  bool
+  Prefer(SizeValueType s, SizeValueType c) const
+  {
+    return m_CellDiameter[s] > m_CellDiameter[c] || (m_CellDiameter[s] == m_CellDiameter[c] && s < c);
+  }
+
+  /** Triangle t of level-0 cell s, whose rho reached R - d, is deferred
+   * when its motion against the box of a neighbouring cell c of which s is
+   * preferred (Prefer()), or against another triangle u of its own cell
+   * with a smaller displacement box (the lower index on a tie), reaches
+   * R - d. A pair (t, u) whose motion reaches R - d has t's motion against
+   * u (and u's cell) and u's against t (and t's cell) reach it, so the
+   * preferred side of the two is deferred: the ones that moved, not every
+   * triangle around them. */
+  bool
+  DeferByRho(SizeValueType t, SizeValueType s, double d) const
+  {
+    const CellLevel & base = m_Levels[0];
+    const float *     bt = m_TriangleDelta.data() + 6 * t;
+    const double      limit = m_Radius - d;
+    for (IndexType k = base.neighbourOffsets[s]; k < base.neighbourOffsets[s + 1]; ++k)
+    {
+      const IndexType c = base.neighbours[k];
+      if (c != s && this->Prefer(s, c) && !(LargestDistance(bt, base.boxes.data() + 6 * c) < limit))
+      {
+        return true;
+      }
+    }
+    const double diameter = LargestDistance(bt, bt);
+    for (IndexType i = m_CellOffsets[s]; i < m_CellOffsets[s + 1]; ++i)
+    {
+      const IndexType u = m_CellOrder[i];
+      const float *   bu = m_TriangleDelta.data() + 6 * u;
+      if (u == t || !(LargestDistance(bt, bu) >= limit))
+      {
+        continue;
+      }
+      const double other = LargestDistance(bu, bu);
+      if (diameter > other || (diameter == other && t < u))
+      {
+        return true;
+      }
+    }
+    return false;
+  }
+
+  /** The pairs of level 1 of the pyramid at the resolution of level 0, for
+   * a level-1 cell \a cell whose own test failed: every pair of a triangle
+   * of one of its level-0 cells s with a triangle of a level-0 cell c that
+   * is not a neighbour of s but whose parent neighbours s's parent. Two
+   * such cells, with coordinates differing by D_k along axis k, hold
+   * centroids at least h sqrt(sum_k max(0, |D_k| - 1)^2) apart (h the
+   * level-0 cell size), so their triangles are at least that less the
+   * cells' largest radii apart: a bound per pair of cells, from their own
+   * radii and displacement boxes, instead of the level-1 cell's union over
+   * 27 cells of twice the size and the largest radius around it. A pair of
+   * cells that this does not clear fails the level-1 test of both parents,
+   * so it is seen from both sides; the preferred cell of the two
+   * (Prefer()) is marked (m_CellDeferred): its triangles are deferred
+   * (Bound()), i.e. query the grid of the boxes at the reference for every
+   * pair that may have come within d. (A level-1 failure made most of the
+   * rebuilds of a converging brain surface.) */
+  void
+  DeferLevelOneCell(SizeValueType cell, double d)
+  {
+    const CellLevel & base = m_Levels[0];
+    const CellLevel & one = m_Levels[1];
+    const uint64_t    mask = (uint64_t{ 1 } << KeyBits) - 1;
+    const double      h = base.cellSize;
+    const auto gap = [](int64_t delta) { return static_cast<double>(std::max<int64_t>(0, std::abs(delta) - 1)); };
+    for (IndexType o = one.childOffsets[cell]; o < one.childOffsets[cell + 1]; ++o)
+    {
+      const IndexType s = one.children[o];
+      const uint64_t  key = base.keys[s];
+      const auto      ci = static_cast<int64_t>((key >> (2 * KeyBits)) & mask);
+      const auto      cj = static_cast<int64_t>((key >> KeyBits) & mask);
+      const auto      ck = static_cast<int64_t>(key & mask);
+      const float *   bs = base.boxes.data() + 6 * s;
+      const auto      clear = [&]() {
+        for (int64_t di = -3; di <= 3; ++di)
+        {
+          for (int64_t dj = -3; dj <= 3; ++dj)
+          {
+            if (ci + di < 0 || cj + dj < 0)
+            {
+              continue;
+            }
+            const auto i = static_cast<uint64_t>(ci + di);
+            const auto j = static_cast<uint64_t>(cj + dj);
+            const auto first = Key(i, j, static_cast<uint64_t>(std::max<int64_t>(0, ck - 3)));
+            const auto last = Key(i, j, static_cast<uint64_t>(ck + 3));
+            for (auto c = std::lower_bound(base.keys.begin(), base.keys.end(), first);
+                 c != base.keys.end() && *c <= last;
+                 ++c)
+            {
+              const int64_t dk = static_cast<int64_t>(*c & mask) - ck;
+              if ((std::abs(di) <= 1 && std::abs(dj) <= 1 && std::abs(dk) <= 1) ||
+                  std::abs(((ci + di) >> 1) - (ci >> 1)) > 1 || std::abs(((cj + dj) >> 1) - (cj >> 1)) > 1 ||
+                  std::abs(((ck + dk) >> 1) - (ck >> 1)) > 1)
+              {
+                continue; // level 0's pairs, or level 2's and above
+              }
+              const double cells = std::sqrt(gap(di) * gap(di) + gap(dj) * gap(dj) + gap(dk) * gap(dk));
+              const auto   other = static_cast<SizeValueType>(c - base.keys.begin());
+              // At least level 1's own separation less the radii (cells >= 1,
+              // radii no larger), so that a pair this does not clear fails
+              // the level-1 test of both its cells' parents (Prefer()).
+              const double separation = h * cells - (base.radii[s] + base.radii[other]) * (1.0 + 1e-9) - d;
+              if (this->Prefer(s, other) && !(LargestDistance(bs, base.boxes.data() + 6 * other) < separation))
+              {
+                return false;
+              }
+            }
+          }
+        }
+        return true;
+      };
+      if (!clear())
+      {
+        m_CellDeferred[s] = 1;
+      }
+    }
   }
 
   /** The uniform grid of the triangles' boxes swept from x to y, widened by
@@ -3183,6 +3486,12 @@ private:
   std::vector<float>              m_VertexDelta;   // per point: y - r, as a box rounded outward
   std::vector<float>              m_TriangleDelta; // per triangle: box of its points' y - r
   std::vector<uint8_t>            m_Active;
+  std::vector<uint8_t>            m_IsDeferred;       // per triangle: rho reached R - d, or level 1 failed (Bound())
+  std::vector<uint8_t>            m_CellDeferred;     // per level-0 cell: level 1 did not clear it (Bound())
+  std::vector<double>             m_CellDiameter;     // per level-0 cell: its displacement box's diameter (Bound())
+  std::vector<IndexType>          m_Deferred;         // those triangles
+  SizeValueType                   m_DeferredSum{ 0 }; // deferred triangles summed over the steps since the rebuild
+  SizeValueType                   m_NumberOfDeferredTriangles{ 0 };
   float                           m_GlobalDelta[6]{};
   SizeValueType                   m_NumberOfTestedTriangles{ 0 };
   std::vector<float>              m_SweptBoxes;

@@ -275,9 +275,8 @@ Flatten(const MeshType * mesh, std::vector<double> & x, std::vector<uint32_t> & 
  * by (0.13, 0.07) in its plane: 3 doubles a point in x, 3 indices a triangle
  * in triangles; the upper sheet's points are the second half. */
 void
-TwoSheets(double gap, std::vector<double> & x, std::vector<uint32_t> & triangles)
+TwoSheets(double gap, std::vector<double> & x, std::vector<uint32_t> & triangles, unsigned int m = 12)
 {
-  const unsigned int m = 12;
   x.clear();
   triangles.clear();
   for (unsigned int sheet = 0; sheet < 2; ++sheet)
@@ -562,7 +561,7 @@ TEST(SurfaceCollision, ACarriedSharedGapLosesThePairsMotion)
 
   y[11] -= 0.1;
   y[14] -= 0.1;
-  y[3 * 6] += 3.0;
+  y[3 * 6] += 30.0;
   const auto first = collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1);
   ASSERT_TRUE(first.rebuilt) << "the far triangle's stretch exceeds the bounds";
   EXPECT_EQ(first.violations, 0u);
@@ -874,6 +873,52 @@ TEST(SurfaceCollision, ALargeTriangleStopsAtDBelowSmallOnes)
   }
   EXPECT_LT(unconstrained, d) << "the proposed steps would have come within d";
   EXPECT_LT(x[3 * 12 + 2], 0.3) << "the corner stopped below the upper sheet";
+}
+
+TEST(SurfaceCollision, AFanMovingAloneIsDeferredAndStopsAtD)
+{
+  // Two sheets of 25 x 25 points 1.2 apart (edges 0.5, d = 0.1, so
+  // R = d + 0.75 mean edges, about 0.53): the middle point of the lower
+  // sheet rises by 0.1 a step, nothing else moves. Its six triangles move
+  // against the cells around them; from a motion of R - d their pairs with
+  // the upper sheet (no candidates at the reference, 1.2 apart) are no
+  // longer bounded by the index: the triangles are deferred and query the
+  // grid of the reference boxes at every step, instead of the index being
+  // rebuilt. Without those queries the point passes the upper sheet (z = 2
+  // after 20 steps, no pair seen); unconstrained it would too.
+  std::vector<double>   x;
+  std::vector<uint32_t> triangles;
+  const unsigned int    m = 24;
+  TwoSheets(1.2, x, triangles, m);
+  const std::size_t n = x.size() / 3;
+  const std::size_t p = (m / 2) * (m + 1) + m / 2;
+  const double      d = 0.1;
+  ASSERT_GE(CheckAllPairs(x, triangles, d).smallestDistance, d);
+  itk::SurfaceCollision collision;
+  collision.SetSurface(n, triangles.data(), triangles.size() / 3);
+  double       unconstrained = std::numeric_limits<double>::infinity();
+  unsigned int deferredSteps = 0;
+  unsigned int constrainedSteps = 0;
+  for (unsigned int step = 0; step < 20; ++step)
+  {
+    std::vector<double> y = x;
+    y[3 * p + 2] += 0.1;
+    unconstrained = std::min(unconstrained, CheckAllPairs(y, triangles, d).smallestDistance);
+    const auto result = collision.Constrain(x.data(), y.data(), d, nullptr, 1);
+    deferredSteps += collision.GetNumberOfDeferredTriangles() > 0 ? 1 : 0;
+    constrainedSteps += result.constrained > 0 ? 1 : 0;
+    const BruteForce check = CheckAllPairs(y, triangles, d);
+    ASSERT_EQ(check.intersecting, 0u) << "step " << step;
+    ASSERT_GE(check.smallestDistance, d - 1e-9) << "step " << step;
+    x = y;
+  }
+  EXPECT_LT(unconstrained, d) << "the proposed steps would have come within d";
+  EXPECT_LT(x[3 * p + 2], 1.2 - d + 1e-9) << "the point stopped below the upper sheet";
+  EXPECT_GE(deferredSteps, 10u) << "the fan's pairs were found by its grid queries";
+  EXPECT_GE(constrainedSteps, 1u);
+  EXPECT_LE(collision.GetNumberOfRebuilds(), 2u) << "a fan moving alone does not rebuild the index";
+  std::cout << deferredSteps << " steps with deferred triangles, " << collision.GetNumberOfRebuilds() << " rebuilds"
+            << std::endl;
 }
 
 TEST(SurfaceCollision, ALargeTriangleMovingAloneStopsAtD)
