@@ -1068,8 +1068,8 @@ OutwardFloats(double low, double high, float & below, float & above)
   constexpr double largest = std::numeric_limits<float>::max();
   const auto       lo = static_cast<float>(std::min(std::max(low, -largest), largest));
   const auto       hi = static_cast<float>(std::min(std::max(high, -largest), largest));
-  below = lo - (std::abs(lo) * 0x1p-23f + 1e-30f);
-  above = hi + (std::abs(hi) * 0x1p-23f + 1e-30f);
+  below = lo - (std::abs(lo) * (1.0f / 8388608.0f) + 1e-30f);
+  above = hi + (std::abs(hi) * (1.0f / 8388608.0f) + 1e-30f);
 }
 
 /** Writes the float box of the points (3 doubles each) given, widened by

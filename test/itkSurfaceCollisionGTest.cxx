@@ -322,6 +322,92 @@ TwoSheetsWithLargeCorners(double gap, std::vector<double> & x, std::vector<uint3
 // ---------------------------------------------------------------------------
 // Known configurations.
 
+TEST(SurfaceCollision, OutwardFloatsEncloseTheDouble)
+{
+  // The branchless rounding of the displacement boxes: below <= m <= above
+  // for every double, at most six units in the last place of the nearest
+  // float (plus the absolute 1e-30 each side) apart for normal magnitudes;
+  // zero, subnormals and values beyond the floats' range included.
+  std::mt19937                           random(20261204);
+  std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
+  std::uniform_int_distribution<int>     exponent(-140, 140);
+  std::vector<double>                    values = {
+                       0.0,  -0.0,  1e-300, -1e-300, 1e-45, -1e-45, 1.0, -1.0, 3.4028234663852886e38, -3.4028234663852886e38,
+                       1e39, -1e39, 1e300,  -1e300
+  };
+  for (unsigned int i = 0; i < 100000; ++i)
+  {
+    values.push_back(std::ldexp(mantissa(random), exponent(random)));
+  }
+  for (const double m : values)
+  {
+    float below = 0.0f, above = 0.0f;
+    itk::SurfaceCollisionDetail::OutwardFloats(m, m, below, above);
+    ASSERT_LE(static_cast<double>(below), m) << m;
+    ASSERT_GE(static_cast<double>(above), m) << m;
+    const auto nearest = static_cast<float>(m);
+    if (std::isfinite(nearest) && std::abs(nearest) >= std::numeric_limits<float>::min())
+    {
+      const float ulp = std::nextafter(std::abs(nearest), std::numeric_limits<float>::infinity()) - std::abs(nearest);
+      ASSERT_LE(static_cast<double>(above) - static_cast<double>(below), 6.0 * ulp + 2.1e-30) << m;
+    }
+  }
+}
+
+TEST(SurfaceCollision, SpheresWithinFindsWhatTheScalarTestFinds)
+{
+  // The filter of the rebuild's candidate search against a plain loop, on
+  // random spheres, with ranges that do not start or end on a multiple of 4.
+  std::mt19937                          random(7);
+  std::uniform_real_distribution<float> coordinate(-5.0f, 5.0f);
+  std::uniform_real_distribution<float> radius(0.0f, 1.0f);
+  const uint32_t                        count = 1003;
+  std::vector<float>                    x(count + 4), y(count + 4), z(count + 4), r(count + 4);
+  for (uint32_t j = 0; j < count; ++j)
+  {
+    x[j] = coordinate(random);
+    y[j] = coordinate(random);
+    z[j] = coordinate(random);
+    r[j] = radius(random);
+  }
+  std::vector<uint32_t> hits(count + 4);
+  std::size_t           total = 0;
+  for (uint32_t first = 0; first < 40; first += 7)
+  {
+    for (const uint32_t last : { count, count - 1, count - 2, count - 3, first, first + 1 })
+    {
+      const float              px = coordinate(random), py = coordinate(random), pz = coordinate(random);
+      const float              reach = 2.0f * radius(random);
+      const itk::SizeValueType found = itk::SurfaceCollisionDetail::SpheresWithin(
+        x.data(), y.data(), z.data(), r.data(), first, last, px, py, pz, reach, hits.data());
+      // In double: found when clearly inside, not found when clearly
+      // outside (the float sums may round either way at the boundary).
+      std::vector<char> isHit(count, 0);
+      for (itk::SizeValueType h = 0; h < found; ++h)
+      {
+        ASSERT_TRUE(hits[h] >= first && hits[h] < last && (h == 0 || hits[h] > hits[h - 1])) << hits[h];
+        isHit[hits[h]] = 1;
+      }
+      for (uint32_t j = first; j < last; ++j)
+      {
+        const double dx = double{ x[j] } - px, dy = double{ y[j] } - py, dz = double{ z[j] } - pz;
+        const double limit = double{ r[j] } + reach;
+        const double sum = dx * dx + dy * dy + dz * dz;
+        if (sum < limit * limit * (1.0 - 1e-5))
+        {
+          ASSERT_TRUE(isHit[j]) << "range " << first << " to " << last << ", sphere " << j;
+        }
+        if (sum > limit * limit * (1.0 + 1e-5))
+        {
+          ASSERT_FALSE(isHit[j]) << "range " << first << " to " << last << ", sphere " << j;
+        }
+      }
+      total += found;
+    }
+  }
+  EXPECT_GT(total, 100u) << "the spheres were near enough to be found";
+}
+
 TEST(SurfaceCollision, ParallelTrianglesAtDistanceDGiveDExactly)
 {
   const Triangle a = { { 0, 0, 0 }, { 4, 0, 0 }, { 0, 4, 0 } };
