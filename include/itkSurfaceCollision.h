@@ -1174,13 +1174,14 @@ StoreBox(const double * lower, const double * upper, double margin, float * box)
  * candidates, it queries at that step a grid of the boxes at the reference
  * for every triangle within d plus its motion against the 27 cells around
  * its own. Level 1's test, when it fails for a cell, is redone per pair of
- * level-0 cells within 3 cells of each other along each axis (with their
+ * level-0 cells that are not neighbours but whose parents are (with their
  * own separation, radii and boxes: their centroids are at least h
  * sqrt(sum_k max(0, |D_k| - 1)^2) apart for coordinates differing by D_k),
  * and the triangles of the level-0 cells it does not clear are deferred
  * (their motion taken against the 27 level-1 cells around their parent).
- * On a converging surface a few triangles moving against the rest made
- * most rebuilds. When a level above 1 fails, or more than 1/64 of the
+ * Of the two sides of a pair that is not bounded only the one that moved
+ * (the larger displacement box) is deferred. On a converging surface a few
+ * triangles moving against the rest made most rebuilds. When a level above 1 fails, or more than 1/64 of the
  * triangles are deferred at one step or 1/4 summed over the steps since
  * the rebuild, the index is rebuilt at the proposed positions y (where
  * every displacement is zero, so that every bound holds); a pair that
@@ -1636,12 +1637,13 @@ public:
       {
         violating.insert(violating.end(), block.begin(), block.end());
       }
-      // The deferred triangles (rho reached R - d, Bound()): their
-      // candidates and shared pairs were tested above (they are active);
-      // their other pairs were at least R apart at the reference and move
-      // by at most the largest distance between t's displacement box and
-      // the box of all displacements (at least rho), so every triangle
-      // whose box at the reference comes within d plus that motion.
+      // The deferred triangles (Bound()): their candidates and shared pairs
+      // are tested above when their rho reaches their clearance; their
+      // other pairs that the levels do not bound were at least R apart at
+      // the reference and move by at most the largest distance between t's
+      // displacement box and the union of the cells around it
+      // (DeferredMotion()), so every triangle whose box at the reference
+      // comes within d plus that motion.
       m_NumberOfTestedTriangles += m_Deferred.size();
       if (!m_Deferred.empty())
       {
