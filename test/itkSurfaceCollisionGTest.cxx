@@ -345,9 +345,10 @@ TEST(SurfaceCollision, OutwardFloatsEncloseTheDouble)
     itk::SurfaceCollisionDetail::OutwardFloats(m, m, below, above);
     ASSERT_LE(static_cast<double>(below), m) << m;
     ASSERT_GE(static_cast<double>(above), m) << m;
-    const auto nearest = static_cast<float>(m);
-    if (std::isfinite(nearest) && std::abs(nearest) >= std::numeric_limits<float>::min())
+    if (std::abs(m) <= static_cast<double>(std::numeric_limits<float>::max()) &&
+        std::abs(m) >= static_cast<double>(std::numeric_limits<float>::min()))
     {
+      const auto  nearest = static_cast<float>(m);
       const float ulp = std::nextafter(std::abs(nearest), std::numeric_limits<float>::infinity()) - std::abs(nearest);
       ASSERT_LE(static_cast<double>(above) - static_cast<double>(below), 6.0 * ulp + 2.1e-30) << m;
     }
