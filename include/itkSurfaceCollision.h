@@ -1607,26 +1607,8 @@ public:
           }
           // Otherwise every triangle whose box at the reference comes
           // within d plus that motion.
-          double lo[3], hi[3];
-          TriangleBox(m_Reference.data(), m_Triangles.data() + 3 * t, lo, hi);
-          float query[6];
-          SurfaceCollisionDetail::StoreBox(lo, hi, globalMotion + d, query);
-          const double * st = m_Spheres.data() + 4 * t;
-          m_ReferenceGrid.ForEachOverlapOfBox(query, t, [&](SizeValueType u) {
-            if ((m_IsLarge[u] && u < t) ||
-                SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
-            {
-              return;
-            }
-            const double * su = m_Spheres.data() + 4 * u;
-            double         e[3];
-            SurfaceCollisionDetail::Subtract(st, su, e);
-            const double gap = std::sqrt(SurfaceCollisionDetail::Dot(e, e)) - st[3] - su[3];
-            if (LargestDistance(bt, m_TriangleDelta.data() + 6 * u) < gap - d)
-            {
-              return;
-            }
-            if (this->Violates(t, u, x, y, d))
+          this->ForEachGridPartner(t, globalMotion, d, [&](SizeValueType u) {
+            if (!(m_IsLarge[u] && u < t) && this->Violates(t, u, x, y, d))
             {
               report(t, u);
             }
