@@ -1181,12 +1181,15 @@ StoreBox(const double * lower, const double * upper, double margin, float * box)
  * (their motion taken against the 27 level-1 cells around their parent).
  * Of the two sides of a pair that is not bounded only the one that moved
  * (the larger displacement box) is deferred. On a converging surface a few
- * triangles moving against the rest made most rebuilds. When a level above 1 fails, or more than 1/64 of the
- * triangles are deferred at one step or 1/4 summed over the steps since
- * the rebuild, the index is rebuilt at the proposed positions y (where
- * every displacement is zero, so that every bound holds); a pair that
- * violates the constraint at y is then closer than d at the reference,
- * within its triangles' clearance, and tested.
+ * triangles moving against the rest made most rebuilds. When a level
+ * above 1 fails, or more than 1/64 of the triangles are deferred at one
+ * step or 1/4 summed over the steps since the rebuild, or the deferred
+ * triangles' grid queries have visited 4 boxes per triangle since the
+ * rebuild (a surface in contact and moving everywhere), the index is
+ * rebuilt at the proposed positions y (where every displacement is zero,
+ * so that every bound holds); a pair that violates the constraint at y is
+ * then closer than d at the reference, within its triangles' clearance,
+ * and tested.
  * Only the triangles whose rho_t reaches their clearance ("tested
  * triangles") have their candidate pairs looked at, each first against the
  * pair's own bound (the largest distance between the two triangles' boxes
@@ -1633,6 +1636,7 @@ public:
       }
       const SizeValueType                                       deferredBlocks = (m_Deferred.size() + 63) / 64;
       std::vector<std::vector<std::pair<IndexType, IndexType>>> deferredFound(deferredBlocks);
+      std::vector<SizeValueType>                                deferredVisits(deferredBlocks, 0);
       const auto                                                deferredParallel = [&](auto && body) {
         if (deferredBlocks < 2 || threader == nullptr || workUnits < 2)
         {
@@ -1652,7 +1656,7 @@ public:
         for (SizeValueType l = 64 * b; l < std::min<SizeValueType>(m_Deferred.size(), 64 * (b + 1)); ++l)
         {
           const IndexType t = m_Deferred[l];
-          this->ForEachGridPartner(t, this->DeferredMotion(t), d, [&](SizeValueType u) {
+          deferredVisits[b] += this->ForEachGridPartner(t, this->DeferredMotion(t), d, [&](SizeValueType u) {
             if (this->Violates(t, u, x, y, d))
             {
               out.emplace_back(static_cast<IndexType>(std::min<SizeValueType>(t, u)),
@@ -1661,9 +1665,10 @@ public:
           });
         }
       });
-      for (const auto & block : deferredFound)
+      for (SizeValueType b = 0; b < deferredBlocks; ++b)
       {
-        violating.insert(violating.end(), block.begin(), block.end());
+        violating.insert(violating.end(), deferredFound[b].begin(), deferredFound[b].end());
+        m_DeferredWork += deferredVisits[b];
       }
     }
     else
@@ -1925,6 +1930,14 @@ private:
    * rebuild costs per triangle). */
   static constexpr SizeValueType DeferredPerStep = 64;
   static constexpr SizeValueType DeferredPerRebuild = 4;
+  /** ... and while their grid queries (and the halving loop's, while some
+   * are deferred) have visited fewer than this many boxes per triangle
+   * (at least 1024 triangles) since the rebuild. Where the deferred
+   * triangles' motion is large each query visits many boxes: from the
+   * sphere 0,-18,10,40 on ch2bet, whose 65 538-point level runs 500
+   * iterations in contact, without this budget deferral cost 65 to 110 s
+   * of that level; with 16 boxes 70 s; with 4 as without deferral. */
+  static constexpr SizeValueType DeferredVisitsPerTriangle = 4;
 
   enum class BoundStatus
   {
@@ -2145,12 +2158,16 @@ private:
       return;
     }
     this->EnsureReferenceGrid();
-    this->ForEachGridPartner(t, globalMotion, d, [&](SizeValueType u) {
+    const SizeValueType visited = this->ForEachGridPartner(t, globalMotion, d, [&](SizeValueType u) {
       if (m_IsLarge[t] || m_IsLarge[u] || m_IsDeferred[t] || m_IsDeferred[u])
       {
         f(u);
       }
     });
+    if (!m_Deferred.empty())
+    {
+      m_DeferredWork += visited;
+    }
   }
 
   /** A bound of the motion of deferred triangle t against every triangle
@@ -2176,9 +2193,10 @@ private:
    * (\a motion bounds t's displacement against every other; the grid must
    * be built, EnsureReferenceGrid()). */
   template <typename TFunction>
-  void
+  SizeValueType
   ForEachGridPartner(SizeValueType t, double motion, double d, TFunction && f) const
   {
+    SizeValueType visited = 0;
     const float * bt = m_TriangleDelta.data() + 6 * t;
     double        lo[3], hi[3];
     TriangleBox(m_Reference.data(), m_Triangles.data() + 3 * t, lo, hi);
@@ -2186,6 +2204,7 @@ private:
     SurfaceCollisionDetail::StoreBox(lo, hi, motion + d, query);
     const double * st = m_Spheres.data() + 4 * t;
     m_ReferenceGrid.ForEachOverlapOfBox(query, t, [&](SizeValueType u) {
+      ++visited;
       if (SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
       {
         return;
@@ -2200,6 +2219,7 @@ private:
       }
       f(u);
     });
+    return visited;
   }
 
   /** Builds the grid of every triangle's box at the reference (widened by
@@ -3047,6 +3067,7 @@ private:
     m_IsDeferred.assign(numberOfTriangles, 0);
     m_Deferred.clear();
     m_DeferredSum = 0;
+    m_DeferredWork = 0;
     m_IndexValid = true;
     return true;
   }
@@ -3239,7 +3260,8 @@ private:
       m_DeferredSum += m_Deferred.size();
     }
     if (m_Deferred.size() > std::max<SizeValueType>(numberOfTriangles / DeferredPerStep, 64) ||
-        m_DeferredSum > std::max<SizeValueType>(numberOfTriangles / DeferredPerRebuild, 1024))
+        m_DeferredSum > std::max<SizeValueType>(numberOfTriangles / DeferredPerRebuild, 1024) ||
+        m_DeferredWork > DeferredVisitsPerTriangle * std::max<SizeValueType>(numberOfTriangles, 1024))
     {
       return BoundStatus::Exceeded;
     }
@@ -3476,6 +3498,7 @@ private:
   std::vector<IndexType>          m_Deferred;         // those triangles
   SizeValueType                   m_DeferredSum{ 0 }; // deferred triangles summed over the steps since the rebuild
   SizeValueType                   m_NumberOfDeferredTriangles{ 0 };
+  SizeValueType                   m_DeferredWork{ 0 }; // boxes visited by their grid queries since the rebuild
   float                           m_GlobalDelta[6]{};
   SizeValueType                   m_NumberOfTestedTriangles{ 0 };
   std::vector<float>              m_SweptBoxes;
