@@ -532,7 +532,16 @@ public:
    * and polygons (fan-triangulated) take part; lines do not. Only the
    * positions are checked, not the paths between them (a front can skip
    * across a gap narrower than its step; MinimumDistance above the largest
-   * step makes that impossible). Default: off (results and speed of the step
+   * step makes that impossible). With adaptive remeshing
+   * (RemeshingEdgeLength > 0) the remeshed surface is checked too: the
+   * pairs that a remeshing would bring into contact (sharing no vertex and
+   * closer than MinimumDistance or intersecting, or sharing one vertex and
+   * folded into each other) have the points of their triangles and the
+   * neighbours of those points locked (DeformableMeshRemesher's
+   * SetLockedVertices()), and the remeshing is made again from the same
+   * surface, until it brings no pair into contact; the locked points of the
+   * last remeshing are counted by GetNumberOfPointsLockedByRemeshing().
+   * Default: off (results and speed of the step
    * exactly as without it; the test costs a pass over the vertices and one
    * over the triangles per iteration on a surface that has settled, more
    * where it moves fast). */
@@ -616,6 +625,11 @@ public:
 
   /** Number of remeshings since the last reset. */
   itkGetConstMacro(NumberOfRemeshings, SizeValueType);
+
+  /** Points that the last remeshing left as they were because remeshing
+   * their neighbourhood brought the surface into contact with itself
+   * (PreventSelfIntersections on; see there). 0 when nothing was locked. */
+  itkGetConstMacro(NumberOfPointsLockedByRemeshing, SizeValueType);
 
   /** When on (default), an input whose numbering is not local is renumbered
    * internally at reset (see the class documentation). Off keeps the
@@ -748,6 +762,13 @@ private:
   void
   Remesh();
 
+  /** With PreventSelfIntersections: remeshes again from \a x and
+   * \a triangles (the surface before the remeshing, clear) with the points
+   * around the contacts that the remeshing made locked, until it makes
+   * none. */
+  void
+  RemeshWithoutContacts(const std::vector<double> & x, const std::vector<IndexType32> & triangles);
+
   /** Diagnostics in the output's numbering, when the points are renumbered. */
   void
   PublishDiagnostics();
@@ -868,6 +889,7 @@ private:
   bool                     m_Renumbered{ false };
   double                   m_FarEdgeFraction{ 0.0 };
   SizeValueType            m_NumberOfRemeshings{ 0 };
+  SizeValueType            m_NumberOfPointsLockedByRemeshing{ 0 };
   // The surface's triangles in the internal numbering (remeshing only).
   std::vector<IndexType32> m_Triangles;
   DeformableMeshRemesher   m_Remesher;

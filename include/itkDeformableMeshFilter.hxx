@@ -928,6 +928,7 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
     std::vector<IndexType32>().swap(m_Triangles);
   }
   m_NumberOfRemeshings = 0;
+  m_NumberOfPointsLockedByRemeshing = 0;
   m_Remesher.ForgetTable();
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
   // The kernels load 4 doubles from a point's 3 coordinates: both arrays
@@ -1548,7 +1549,18 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
   x.resize(3 * numberOfPoints); // the guard value goes
   m_Remesher.SetTargetEdgeLength(m_RemeshingEdgeLength);
   m_Remesher.SetMultiThreader(this->GetMultiThreader(), this->GetNumberOfWorkUnits());
-  m_Remesher.Remesh(x, numberOfPoints, m_Triangles);
+  m_NumberOfPointsLockedByRemeshing = 0;
+  if (m_PreventSelfIntersections)
+  {
+    const std::vector<double>      before(x);
+    const std::vector<IndexType32> beforeTriangles(m_Triangles);
+    m_Remesher.Remesh(x, numberOfPoints, m_Triangles);
+    this->RemeshWithoutContacts(before, beforeTriangles);
+  }
+  else
+  {
+    m_Remesher.Remesh(x, numberOfPoints, m_Triangles);
+  }
   if (!m_Remesher.GetTopologyChanged() && x.size() == 3 * numberOfPoints)
   {
     // Only positions moved (relaxation): the numbering, the cells, the
@@ -1612,6 +1624,108 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
 
 template <typename TMesh, typename TForceImage>
 void
+DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vector<double> &      before,
+                                                                const std::vector<IndexType32> & beforeTriangles)
+{
+  std::vector<double> & x = this->GetCoordinates();
+  const SizeValueType   numberOfPoints = before.size() / 3;
+  // The input's triangles as sorted triples of point indices, sorted: a
+  // remeshed triangle whose points did not move and whose triple is one of
+  // these is the input's triangle, unchanged.
+  using Triple = std::array<IndexType32, 3>;
+  const auto sorted = [](IndexType32 a, IndexType32 b, IndexType32 c) {
+    Triple t{ { a, b, c } };
+    std::sort(t.begin(), t.end());
+    return t;
+  };
+  std::vector<Triple> inputTriangles(beforeTriangles.size() / 3);
+  for (SizeValueType t = 0; t < inputTriangles.size(); ++t)
+  {
+    inputTriangles[t] = sorted(beforeTriangles[3 * t], beforeTriangles[3 * t + 1], beforeTriangles[3 * t + 2]);
+  }
+  std::sort(inputTriangles.begin(), inputTriangles.end());
+
+  std::vector<uint8_t> locked(numberOfPoints, 0);
+  std::vector<uint8_t> changed;
+  std::vector<uint8_t> contacts;
+  std::vector<uint8_t> seeds;
+  for (;;)
+  {
+    const std::vector<IndexType32> & parents = m_Remesher.Parents();
+    const SizeValueType              remeshedPoints = parents.size();
+    const SizeValueType              remeshedTriangles = m_Triangles.size() / 3;
+    const auto                       moved = [&](IndexType32 v) {
+      const IndexType32 p = parents[v];
+      return x[3 * v] != before[3 * p] || x[3 * v + 1] != before[3 * p + 1] || x[3 * v + 2] != before[3 * p + 2];
+    };
+    changed.assign(remeshedTriangles, 0);
+    for (SizeValueType t = 0; t < remeshedTriangles; ++t)
+    {
+      const IndexType32 * v = m_Triangles.data() + 3 * t;
+      changed[t] = moved(v[0]) || moved(v[1]) || moved(v[2]) ||
+                   !std::binary_search(
+                     inputTriangles.begin(), inputTriangles.end(), sorted(parents[v[0]], parents[v[1]], parents[v[2]]));
+    }
+    const SizeValueType found = SurfaceCollision::FindContacts(x.data(),
+                                                               m_Triangles.data(),
+                                                               remeshedTriangles,
+                                                               changed.data(),
+                                                               m_MinimumDistance,
+                                                               contacts,
+                                                               this->GetMultiThreader(),
+                                                               this->GetNumberOfWorkUnits());
+    if (found == 0)
+    {
+      break;
+    }
+    // Lock the input points of the triangles in contact and their
+    // neighbours (the input's triangles around them), then remesh the input
+    // again.
+    seeds.assign(numberOfPoints, 0);
+    for (SizeValueType t = 0; t < remeshedTriangles; ++t)
+    {
+      if (contacts[t] != 0)
+      {
+        for (unsigned int k = 0; k < 3; ++k)
+        {
+          seeds[parents[m_Triangles[3 * t + k]]] = 1;
+        }
+      }
+    }
+    bool grew = false;
+    for (SizeValueType t = 0; t < beforeTriangles.size() / 3; ++t)
+    {
+      const IndexType32 * v = beforeTriangles.data() + 3 * t;
+      if (seeds[v[0]] != 0 || seeds[v[1]] != 0 || seeds[v[2]] != 0)
+      {
+        for (unsigned int k = 0; k < 3; ++k)
+        {
+          grew = grew || locked[v[k]] == 0;
+          locked[v[k]] = 1;
+        }
+      }
+    }
+    x.assign(before.begin(), before.end());
+    m_Triangles = beforeTriangles;
+    if (!grew)
+    {
+      // Every triangle in contact was the input's (cannot happen: a changed
+      // triangle has a point that was not locked); keep the input.
+      std::fill(locked.begin(), locked.end(), uint8_t{ 1 });
+    }
+    m_Remesher.SetLockedVertices(locked);
+    m_Remesher.Remesh(x, numberOfPoints, m_Triangles);
+    m_NumberOfPointsLockedByRemeshing =
+      static_cast<SizeValueType>(std::count(locked.begin(), locked.end(), uint8_t{ 1 }));
+    if (!grew)
+    {
+      break;
+    }
+  }
+}
+
+template <typename TMesh, typename TForceImage>
+void
 DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent indent) const
 {
   Superclass::PrintSelf(os, indent);
@@ -1665,6 +1779,7 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "RemeshingEdgeLength: " << m_RemeshingEdgeLength << std::endl;
   os << indent << "RemeshingInterval: " << m_RemeshingInterval << std::endl;
   os << indent << "NumberOfRemeshings: " << m_NumberOfRemeshings << std::endl;
+  os << indent << "NumberOfPointsLockedByRemeshing: " << m_NumberOfPointsLockedByRemeshing << std::endl;
   os << indent << "RenumberForLocality: " << (m_RenumberForLocality ? "On" : "Off") << std::endl;
   os << indent << "Renumbered: " << (m_Renumbered ? "true" : "false") << " (far edge fraction " << m_FarEdgeFraction
      << ")" << std::endl;

@@ -149,6 +149,20 @@ public:
     m_RelaxationSweeps = sweeps;
   }
 
+  /** Vertices of the next Remesh()'s input (a flag per input vertex, 1:
+   * locked) that no operation touches, as if frozen: they do not move, and
+   * no edge with a locked end-point is split, collapsed or flipped (nor
+   * created by a flip). A triangle whose three vertices are locked comes out
+   * as it went in. DeformableMeshFilter locks the neighbourhoods where a
+   * remeshing would bring the surface into contact with itself. Used by the
+   * next Remesh() only (it then rebuilds its corner table, and the one after
+   * rebuilds it again); an empty vector locks nothing. */
+  void
+  SetLockedVertices(std::vector<uint8_t> locked)
+  {
+    m_Locked = std::move(locked);
+  }
+
   /** Remeshes in place: \a coordinates holds 3 doubles per vertex (at least
    * 3 * numberOfPoints; the rest is ignored and dropped), \a triangles 3
    * vertex indices per triangle. On return both describe the new mesh.
@@ -375,6 +389,7 @@ private:
   std::vector<double>    m_X;
   std::vector<IndexType> m_Parents;
   bool                   m_TableValid{ false };
+  std::vector<uint8_t>   m_Locked;       // SetLockedVertices(), for the next Remesh()
   std::vector<IndexType> m_SplitTouched; // triangles the splits of a pass changed or made
   std::vector<IndexType> m_NewIndex;     // scratch of Compact()
   std::vector<IndexType> m_NewCorner;
@@ -1649,13 +1664,28 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
   std::iota(m_Parents.begin(), m_Parents.end(), IndexType{ 0 });
   // The table of the last output describes this input when it is given
   // again: no need to build it.
-  const bool reuse = m_TableValid && m_State.size() == numberOfPoints && m_V.size() == triangles.size() &&
+  // Locked vertices are frozen in a table of their own, which is not kept.
+  std::vector<uint8_t> locked;
+  locked.swap(m_Locked);
+  const bool lock = std::find(locked.begin(), locked.end(), uint8_t{ 1 }) != locked.end();
+  const bool reuse = !lock && m_TableValid && m_State.size() == numberOfPoints && m_V.size() == triangles.size() &&
                      std::equal(triangles.begin(), triangles.end(), m_V.begin());
   m_TableValid = false;
   if (!reuse)
   {
     m_V.assign(triangles.begin(), triangles.end());
     this->Build(numberOfPoints);
+  }
+  if (lock)
+  {
+    const std::size_t count = std::min(locked.size(), numberOfPoints);
+    for (std::size_t i = 0; i < count; ++i)
+    {
+      if (locked[i] != 0 && m_State[i] != RemesherRemoved)
+      {
+        m_State[i] = RemesherFrozen;
+      }
+    }
   }
   m_TableValid = true;
   for (unsigned int pass = 0; pass < 16 && this->SplitPass(pass == 0); ++pass)
@@ -1671,6 +1701,10 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
   this->CollapsePass();
   this->LengthenPass();
   this->Compact(coordinates, triangles);
+  if (lock)
+  {
+    m_TableValid = false; // its frozen states are not the mesh's
+  }
   return m_Statistics;
 }
 

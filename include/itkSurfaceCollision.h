@@ -1846,6 +1846,133 @@ public:
     return count;
   }
 
+  /** Finds the pairs of triangles in contact that a change of the surface
+   * (a remeshing) must not make: two triangles sharing no vertex that are
+   * closer than \a minimumDistance, or intersect (closer than the contact
+   * distance, 1e-6 of the mean edge length, as in Constrain()), and two
+   * triangles sharing exactly one vertex whose gap (SharedVertexGap()) is
+   * below the contact distance (folded into each other). Only the pairs
+   * with at least one triangle flagged in \a changed (a byte per triangle;
+   * null: every triangle) are tested. Sets to 1 the flag of both triangles
+   * of each pair found in \a contacts (resized to the number of triangles,
+   * zero elsewhere) and returns the number of pairs. \a threader (may be
+   * null) runs the tests over \a workUnits units. */
+  static SizeValueType
+  FindContacts(const double *         x,
+               const IndexType *      triangles,
+               SizeValueType          numberOfTriangles,
+               const uint8_t *        changed,
+               double                 minimumDistance,
+               std::vector<uint8_t> & contacts,
+               MultiThreaderBase *    threader = nullptr,
+               unsigned int           workUnits = 1)
+  {
+    using namespace SurfaceCollisionDetail;
+    contacts.assign(numberOfTriangles, 0);
+    if (numberOfTriangles < 2)
+    {
+      return 0;
+    }
+    double edges = 0.0;
+    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+    {
+      const IndexType * v = triangles + 3 * t;
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        double e[3];
+        Subtract(x + 3 * v[k], x + 3 * v[(k + 1) % 3], e);
+        edges += std::sqrt(Dot(e, e));
+      }
+    }
+    const double       contact = 1e-6 * edges / static_cast<double>(3 * numberOfTriangles);
+    const double       d = std::max(minimumDistance, contact);
+    std::vector<float> boxes(6 * numberOfTriangles);
+    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+    {
+      double lo[3], hi[3];
+      TriangleBox(x, triangles + 3 * t, lo, hi);
+      StoreBox(lo, hi, 0.5 * d, boxes.data() + 6 * t);
+    }
+    BoxGrid grid;
+    grid.Build(boxes.data(), numberOfTriangles);
+    constexpr SizeValueType                                   block = 1024;
+    const SizeValueType                                       blocks = (numberOfTriangles + block - 1) / block;
+    std::vector<std::vector<std::pair<IndexType, IndexType>>> found(blocks);
+    const auto                                                run = [&](SizeValueType b) {
+      auto &              out = found[b];
+      const SizeValueType end = std::min(numberOfTriangles, (b + 1) * block);
+      for (SizeValueType t = b * block; t < end; ++t)
+      {
+        if (changed != nullptr && changed[t] == 0)
+        {
+          continue;
+        }
+        const IndexType * vt = triangles + 3 * t;
+        const double *    a[3] = { x + 3 * vt[0], x + 3 * vt[1], x + 3 * vt[2] };
+        grid.ForEachOverlap(t, [&](SizeValueType u) {
+          // Each pair once: from its lower triangle when both changed.
+          if (u < t && (changed == nullptr || changed[u] != 0))
+          {
+            return;
+          }
+          const IndexType *  vu = triangles + 3 * u;
+          const double *     b[3] = { x + 3 * vu[0], x + 3 * vu[1], x + 3 * vu[2] };
+          const unsigned int shared = SharedVertices(vt, vu);
+          bool               found = false;
+          if (shared == 1)
+          {
+            unsigned int i = 0;
+            unsigned int j = 0;
+            for (unsigned int k = 0; k < 3; ++k)
+            {
+              for (unsigned int l = 0; l < 3; ++l)
+              {
+                if (vt[k] == vu[l])
+                {
+                  i = k;
+                  j = l;
+                }
+              }
+            }
+            found = SharedGapLowerBoundOf(vt, i, vu, j, x, contact) < contact && SharedVertexGap(a, i, b, j) < contact;
+          }
+          else if (shared == 0)
+          {
+            found = !SeparatedBy(a, b, d) && TriangleDistance(a, b) < d;
+          }
+          if (found)
+          {
+            out.emplace_back(static_cast<IndexType>(std::min<SizeValueType>(t, u)),
+                             static_cast<IndexType>(std::max<SizeValueType>(t, u)));
+          }
+        });
+      }
+    };
+    if (threader == nullptr || blocks < 2 || workUnits < 2)
+    {
+      for (SizeValueType b = 0; b < blocks; ++b)
+      {
+        run(b);
+      }
+    }
+    else
+    {
+      threader->SetNumberOfWorkUnits(workUnits);
+      threader->ParallelizeArray(0, blocks, run, nullptr);
+    }
+    SizeValueType count = 0;
+    for (const auto & pairs : found)
+    {
+      for (const auto & pair : pairs)
+      {
+        contacts[pair.first] = 1;
+        contacts[pair.second] = 1;
+        ++count;
+      }
+    }
+    return count;
+  }
+
   /** The triangles of a mesh's cells: triangles as they are, polygons and
    * quadrilaterals fan-triangulated (a, b, c), (a, c, d), ...; other cells
    * ignored. \a cells (may be null) receives the cell identifier of each
@@ -2316,6 +2443,19 @@ private:
     unsigned int      i = 0;
     unsigned int      j = 0;
     this->SharedCorners(q, vt, vu, i, j);
+    return SharedGapLowerBoundOf(vt, i, vu, j, x, enough);
+  }
+
+  /** SharedGapLowerBound() of the triangles \a vt and \a vu (3 point
+   * indices each), which share the point vt[i] == vu[j]. */
+  static double
+  SharedGapLowerBoundOf(const IndexType * vt,
+                        unsigned int      i,
+                        const IndexType * vu,
+                        unsigned int      j,
+                        const double *    x,
+                        double            enough)
+  {
     using namespace SurfaceCollisionDetail;
     const double * v = x + 3 * vt[i];
     double         p[3], q1[3], r[3], s[3];

@@ -29,6 +29,7 @@
 #include "gtest/gtest.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -396,6 +397,84 @@ TEST(DeformableMeshRemesher, KeptTableGivesTheSameMeshAsAFreshOne)
   EXPECT_EQ(kept.Points(), before.Points());
   EXPECT_NE(kept.x, before.x) << "the relaxation moved points";
   EXPECT_GT(statistics.relaxed, 0u);
+}
+
+TEST(DeformableMeshRemesher, LockedVerticesAndTheirTrianglesComeOutAsTheyWentIn)
+{
+  // A sphere of 258 points (edges about 2.2) refined to 0.9 with the points
+  // of the cap z > 5 locked: they keep their coordinates bit for bit, every
+  // triangle of three locked points is in the output (through Parents()),
+  // and the rest of the sphere is refined. The lock holds for one Remesh():
+  // the next one refines the cap too.
+  PointType centre;
+  centre.Fill(0.0);
+  const auto                  sphere = itk::MakeSphereMesh<MeshType>(centre, 10.0, 3);
+  FlatMesh                    m = ToFlat(sphere);
+  const FlatMesh              before = m;
+  std::vector<uint8_t>        locked(m.Points(), 0);
+  std::size_t                 lockedTriangles = 0;
+  itk::DeformableMeshRemesher remesher;
+  remesher.SetTargetEdgeLength(0.9);
+  for (std::size_t i = 0; i < m.Points(); ++i)
+  {
+    locked[i] = m.x[3 * i + 2] > 5.0 ? 1 : 0;
+  }
+  std::set<std::array<IndexType, 3>> lockedInput;
+  for (std::size_t t = 0; t < m.triangles.size() / 3; ++t)
+  {
+    const IndexType * v = m.triangles.data() + 3 * t;
+    if (locked[v[0]] != 0 && locked[v[1]] != 0 && locked[v[2]] != 0)
+    {
+      std::array<IndexType, 3> key{ { v[0], v[1], v[2] } };
+      std::sort(key.begin(), key.end());
+      lockedInput.insert(key);
+    }
+  }
+  ASSERT_GT(lockedInput.size(), 10u);
+  remesher.SetLockedVertices(locked);
+  const auto statistics = remesher.Remesh(m.x, m.Points(), m.triangles);
+  EXPECT_GT(statistics.splits, before.triangles.size() / 3) << "the rest was refined";
+  const auto &                       parents = remesher.Parents();
+  std::set<std::array<IndexType, 3>> lockedOutput;
+  std::size_t                        lockedPoints = 0;
+  for (std::size_t i = 0; i < m.Points(); ++i)
+  {
+    const IndexType p = parents[i];
+    if (locked[p] != 0 && m.x[3 * i] == before.x[3 * p] && m.x[3 * i + 1] == before.x[3 * p + 1] &&
+        m.x[3 * i + 2] == before.x[3 * p + 2])
+    {
+      ++lockedPoints;
+    }
+  }
+  for (std::size_t t = 0; t < m.triangles.size() / 3; ++t)
+  {
+    std::array<IndexType, 3> key{
+      { parents[m.triangles[3 * t]], parents[m.triangles[3 * t + 1]], parents[m.triangles[3 * t + 2]] }
+    };
+    std::sort(key.begin(), key.end());
+    if (lockedInput.count(key) != 0)
+    {
+      lockedOutput.insert(key);
+    }
+  }
+  EXPECT_EQ(lockedPoints, static_cast<std::size_t>(std::count(locked.begin(), locked.end(), uint8_t{ 1 })))
+    << "every locked point kept its coordinates";
+  EXPECT_EQ(lockedOutput, lockedInput) << "every triangle of locked points is in the output";
+  lockedTriangles = lockedOutput.size();
+  const Topology topology = Analyse(m);
+  EXPECT_EQ(topology.badEdges, 0u);
+  EXPECT_EQ(topology.Euler(), 2);
+
+  // The next Remesh() locks nothing: the cap's long edges are split.
+  const std::size_t points = m.Points();
+  remesher.Remesh(m.x, m.Points(), m.triangles);
+  double shortest = 0.0;
+  double longest = 0.0;
+  EdgeLengthRange(m, shortest, longest);
+  EXPECT_LE(longest, remesher.GetMaximumEdgeLength() * (1.0 + 1e-12));
+  EXPECT_GT(m.Points(), points);
+  std::cout << lockedTriangles << " locked triangles kept, " << points << " then " << m.Points() << " points"
+            << std::endl;
 }
 
 TEST(DeformableMeshRemesher, LeavesNonManifoldPartsAlone)
