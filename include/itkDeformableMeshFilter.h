@@ -799,9 +799,12 @@ private:
   ResetCollision(const std::vector<uint32_t> * triangles = nullptr, bool check = true);
 
   /** The collision hook of Iterate(): constrains m_NextCoordinates; keeps
-   * the diagnostics and the blocks' largest displacements right. */
+   * the diagnostics, the blocks' largest displacements, the number of
+   * active vertices and the largest displacement along the normals
+   * (\a largestNormal, computed by FinishStep()) right: they measure the
+   * displacements made, not those proposed. */
   void
-  ConstrainSelfIntersections(std::vector<double> & blockMaximum, bool diagnose);
+  ConstrainSelfIntersections(std::vector<double> & blockMaximum, bool diagnose, double & largestNormal);
 
   /** After the step, when DampOscillations, ConvergenceFraction > 0 or
    * ConvergenceAlongNormals is on: scales each vertex's proposed displacement

@@ -1012,7 +1012,9 @@ DeformableMeshFilter<TMesh, TForceImage>::ResetCollision(const std::vector<uint3
 
 template <typename TMesh, typename TForceImage>
 void
-DeformableMeshFilter<TMesh, TForceImage>::ConstrainSelfIntersections(std::vector<double> & blockMaximum, bool diagnose)
+DeformableMeshFilter<TMesh, TForceImage>::ConstrainSelfIntersections(std::vector<double> & blockMaximum,
+                                                                     bool                  diagnose,
+                                                                     double &              largestNormal)
 {
   using DeformableMeshFilterDetail::BlockSize;
   if (!m_Collision.HasSurface())
@@ -1065,6 +1067,46 @@ DeformableMeshFilter<TMesh, TForceImage>::ConstrainSelfIntersections(std::vector
       largest = std::max(largest, length(i));
     }
     blockMaximum[block] = largest;
+  }
+  // FinishStep() counted the active vertices and the largest displacement
+  // along the normals on the proposed positions: a vertex held against a
+  // contact moves less (or not at all), and the convergence test must see
+  // that, or a surface resting against itself never converges.
+  if (!(m_DampOscillations || m_ConvergenceFraction > 0.0 || m_ConvergenceAlongNormals))
+  {
+    return;
+  }
+  const float * normals = m_ConvergenceAlongNormals ? m_Normals.data() : nullptr;
+  const auto    measured = [&](SizeValueType i, const double * p) {
+    const double d[3] = { p[0] - start[3 * i], p[1] - start[3 * i + 1], p[2] - start[3 * i + 2] };
+    if (normals == nullptr)
+    {
+      return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    }
+    const double along = d[0] * normals[4 * i] + d[1] * normals[4 * i + 1] + d[2] * normals[4 * i + 2];
+    return along * along;
+  };
+  const double                squaredTolerance = m_ConvergenceTolerance * m_ConvergenceTolerance;
+  const auto &                points = m_Collision.GetConstrainedPoints();
+  const std::vector<double> & proposals = m_Collision.GetConstrainedProposals();
+  for (SizeValueType k = 0; k < points.size(); ++k)
+  {
+    const SizeValueType i = points[k];
+    const bool          was = measured(i, proposals.data() + 3 * k) >= squaredTolerance;
+    const bool          is = measured(i, m_NextCoordinates.data() + 3 * i) >= squaredTolerance;
+    if (was && !is && m_NumberOfActiveVertices > 0)
+    {
+      --m_NumberOfActiveVertices;
+    }
+  }
+  if (normals != nullptr)
+  {
+    double largest = 0.0;
+    for (SizeValueType i = 0; i < numberOfPoints; ++i)
+    {
+      largest = std::max(largest, measured(i, m_NextCoordinates.data() + 3 * i));
+    }
+    largestNormal = std::sqrt(largest);
   }
 }
 
@@ -1432,7 +1474,7 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   }
   if (m_PreventSelfIntersections)
   {
-    this->ConstrainSelfIntersections(blockMaximum, diagnose);
+    this->ConstrainSelfIntersections(blockMaximum, diagnose, largestNormal);
   }
   coordinates.swap(m_NextCoordinates);
 

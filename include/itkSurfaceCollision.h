@@ -1391,6 +1391,14 @@ public:
     return m_ModifiedPoints;
   }
 
+  /** The positions proposed for those points (3 doubles each, in the order
+   * of GetConstrainedPoints()), as the last Constrain() received them. */
+  const std::vector<double> &
+  GetConstrainedProposals() const
+  {
+    return m_ModifiedProposals;
+  }
+
   /** Distance below which two triangles count as touching whatever the
    * minimum distance: 1e-6 of the mean edge length (set at each rebuild). */
   double
@@ -1411,6 +1419,7 @@ public:
     const SizeValueType n = m_NumberOfPoints;
     const SizeValueType numberOfTriangles = this->GetNumberOfTriangles();
     m_ModifiedPoints.clear();
+    m_ModifiedProposals.clear();
     m_NumberOfTestedTriangles = 0;
     if (n == 0 || numberOfTriangles < 2)
     {
@@ -1742,6 +1751,7 @@ public:
         if (m_Level[i] == 0)
         {
           m_ModifiedPoints.push_back(i);
+          m_ModifiedProposals.insert(m_ModifiedProposals.end(), y + 3 * i, y + 3 * i + 3);
         }
         if (m_Level[i] >= 3)
         {
@@ -3645,6 +3655,7 @@ private:
   SurfaceCollisionDetail::BoxGrid m_SweptGrid;
   std::vector<uint8_t>            m_Level;
   std::vector<IndexType>          m_ModifiedPoints;
+  std::vector<double>             m_ModifiedProposals; // their y as proposed
 };
 } // end namespace itk
 
