@@ -139,6 +139,8 @@ vtkDeformableMesh::vtkDeformableMesh()
   this->MaximumStepLength = filter->GetMaximumStepLength();
   this->RemeshingEdgeLength = filter->GetRemeshingEdgeLength();
   this->RemeshingInterval = static_cast<int>(filter->GetRemeshingInterval());
+  this->PreventSelfIntersections = filter->GetPreventSelfIntersections() ? 1 : 0;
+  this->MinimumDistance = filter->GetMinimumDistance();
   this->FixedBoundary = filter->GetFixedBoundary() ? 1 : 0;
   this->ConvergenceTolerance = filter->GetConvergenceTolerance();
   this->ConvergenceWindow = static_cast<int>(filter->GetConvergenceWindow());
@@ -427,6 +429,8 @@ vtkDeformableMesh::PrepareFilter(vtkInformationVector ** inputVector)
     filter->SetMaximumStepLength(this->MaximumStepLength);
     filter->SetRemeshingEdgeLength(this->RemeshingEdgeLength);
     filter->SetRemeshingInterval(static_cast<unsigned int>(this->RemeshingInterval));
+    filter->SetPreventSelfIntersections(this->PreventSelfIntersections != 0);
+    filter->SetMinimumDistance(this->MinimumDistance);
     filter->SetFixedBoundary(this->FixedBoundary != 0);
     filter->SetConvergenceTolerance(this->ConvergenceTolerance);
     filter->SetConvergenceWindow(static_cast<unsigned int>(this->ConvergenceWindow));
@@ -446,6 +450,7 @@ vtkDeformableMesh::AddOutputArrays(vtkPolyData * output)
   auto add = [this, output](const auto * filter) {
     this->Converged = filter->GetConverged() ? 1 : 0;
     this->LastMaximumDisplacement = filter->GetLastMaximumDisplacement();
+    this->NumberOfCollisionsPrevented = static_cast<vtkIdType>(filter->GetTotalNumberOfCollisionsPrevented());
     this->NumberOfClosedContours = static_cast<int>(filter->GetNumberOfClosedContours());
     this->NumberOfOpenContours = static_cast<int>(filter->GetNumberOfOpenContours());
     if (!this->ComputeDiagnostics)
@@ -502,6 +507,8 @@ vtkDeformableMesh::PrintSelf(ostream & os, vtkIndent indent)
   os << indent << "MaximumStepLength: " << this->MaximumStepLength << "\n";
   os << indent << "RemeshingEdgeLength: " << this->RemeshingEdgeLength << "\n";
   os << indent << "RemeshingInterval: " << this->RemeshingInterval << "\n";
+  os << indent << "PreventSelfIntersections: " << (this->PreventSelfIntersections ? "On" : "Off") << "\n";
+  os << indent << "MinimumDistance: " << this->MinimumDistance << "\n";
   os << indent << "FixedBoundary: " << (this->FixedBoundary ? "On" : "Off") << "\n";
   os << indent << "ConvergenceTolerance: " << this->ConvergenceTolerance << "\n";
   os << indent << "ConvergenceWindow: " << this->ConvergenceWindow << "\n";
@@ -510,6 +517,7 @@ vtkDeformableMesh::PrintSelf(ostream & os, vtkIndent indent)
   os << indent << "ComputeDiagnostics: " << (this->ComputeDiagnostics ? "On" : "Off") << "\n";
   os << indent << "Converged: " << (this->Converged ? "true" : "false") << "\n";
   os << indent << "LastMaximumDisplacement: " << this->LastMaximumDisplacement << "\n";
+  os << indent << "NumberOfCollisionsPrevented: " << this->NumberOfCollisionsPrevented << "\n";
   os << indent << "NumberOfClosedContours: " << this->NumberOfClosedContours << "\n";
   os << indent << "NumberOfOpenContours: " << this->NumberOfOpenContours << "\n";
   const auto & forces3 = this->DeformableInternals->ForceImage.Image;

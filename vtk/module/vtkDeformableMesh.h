@@ -307,6 +307,33 @@ public:
 
   ///@{
   /**
+   * No step lets the surface intersect itself: the displacements of the
+   * vertices of triangles that would intersect, or come closer than
+   * MinimumDistance, are halved, halved again, then zeroed; a remeshing that
+   * would make contact leaves the contact's neighbourhood as it was. An
+   * input that already intersects itself is an error (the first pair named).
+   * Surfaces only (an error on 2-D contours). Default off.
+   * Meaning in full: itk::DeformableMeshFilter::SetPreventSelfIntersections().
+   */
+  vtkSetMacro(PreventSelfIntersections, vtkTypeBool);
+  vtkGetMacro(PreventSelfIntersections, vtkTypeBool);
+  vtkBooleanMacro(PreventSelfIntersections, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
+   * With PreventSelfIntersections: the smallest distance a step may leave
+   * between two triangles sharing no vertex (0: intersection and contact
+   * only); keep it below half the shortest edge. Millimetres, at least 0;
+   * default 0.
+   * Meaning in full: itk::DeformableMeshFilter::SetMinimumDistance().
+   */
+  vtkSetClampMacro(MinimumDistance, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(MinimumDistance, double);
+  ///@}
+
+  ///@{
+  /**
    * Keep the boundary of an open mesh at its input position, exactly: the
    * ends of open contours (2-D), the boundary of open surfaces and the ends
    * of lines (3-D). Off (default): they move like the other vertices, their
@@ -384,6 +411,14 @@ public:
    */
   vtkGetMacro(LastMaximumDisplacement, double);
 
+  /**
+   * With PreventSelfIntersections: the near-collisions handled since the
+   * last restart (pairs of triangles found violating the constraint, summed
+   * over the iterations).
+   * Meaning in full: itk::DeformableMeshFilter::GetTotalNumberOfCollisionsPrevented().
+   */
+  vtkGetMacro(NumberOfCollisionsPrevented, vtkIdType);
+
   ///@{
   /**
    * 2-D: the closed and open contours found in the input at the last
@@ -424,6 +459,8 @@ protected:
   vtkTypeBool EstimateObjectIntensityRange = 1;
   double      ObjectIntensityRange[2] = { 0.0, 1.0 };
   int         EdgePolarity = 0;
+  vtkTypeBool PreventSelfIntersections = 0;
+  double      MinimumDistance = 0.0;
   vtkTypeBool FixedBoundary = 0;
   double      ConvergenceTolerance = 0.0;
   int         ConvergenceWindow = 3;
@@ -432,6 +469,7 @@ protected:
   vtkTypeBool ComputeDiagnostics = 1;
   vtkTypeBool Converged = 0;
   double      LastMaximumDisplacement = 0.0;
+  vtkIdType   NumberOfCollisionsPrevented = 0;
   int         NumberOfClosedContours = 0;
   int         NumberOfOpenContours = 0;
 

@@ -28,6 +28,7 @@
 
 #include "gtest/gtest.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -108,7 +109,10 @@ XMLDefault(const std::string & xml, const std::string & proxy, const std::string
 std::string
 HelpDefault(const std::string & help, const std::string & option)
 {
-  const auto start = help.find("\n  " + option + " ");
+  // The option, then its argument or, when it is too long for its column,
+  // the end of its line.
+  auto start = help.find("\n  " + option + " ");
+  start = std::min(start, help.find("\n  " + option + "\n"));
   if (start == std::string::npos)
   {
     return "";
@@ -246,6 +250,12 @@ TEST(ParameterDefaults, AgreeInTheITKAndVTKClassesThePluginAndTheCommandLine)
                 static_cast<double>(vtkModel->GetRemeshingInterval()),
                 nullptr,
                 nullptr },
+    { "PreventSelfIntersections",
+                static_cast<double>(itkModel->GetPreventSelfIntersections()),
+                static_cast<double>(vtkModel->GetPreventSelfIntersections()),
+                "--prevent-self-intersections",
+                "off" },
+    { "MinimumDistance", itkModel->GetMinimumDistance(), vtkModel->GetMinimumDistance(), "--minimum-distance", "0" },
     { "FixedBoundary",
                 static_cast<double>(itkModel->GetFixedBoundary()),
                 static_cast<double>(vtkModel->GetFixedBoundary()),
