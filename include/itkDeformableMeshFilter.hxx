@@ -1611,8 +1611,11 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
     ++m_NumberOfRemeshings;
     m_NumberOfCollisionsPrevented = 0;
     m_NumberOfConstrainedVertices = 0;
-    m_Collision.Invalidate();
-    return;
+    if (!m_PreventSelfIntersections)
+    {
+      m_Collision.Invalidate();
+    }
+    return; // with PreventSelfIntersections the index was built at x
   }
   const std::vector<IndexType32> & parents = m_Remesher.Parents();
   const SizeValueType              newNumberOfPoints = parents.size();
@@ -1660,8 +1663,18 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
   // are held from now on.
   this->FindBoundaryVertices(m_Triangles);
   // The collision test's tables for the new mesh (no check: see
-  // ResetCollision()).
-  this->ResetCollision(&m_Triangles, false);
+  // ResetCollision()); with PreventSelfIntersections RemeshWithoutContacts()
+  // has set them and built the index at these positions.
+  if (m_PreventSelfIntersections && m_Collision.HasSurface() && m_Collision.GetNumberOfPoints() == newNumberOfPoints)
+  {
+    m_CollisionTriangles = m_Triangles;
+    m_NumberOfCollisionsPrevented = 0;
+    m_NumberOfConstrainedVertices = 0;
+  }
+  else
+  {
+    this->ResetCollision(&m_Triangles, false);
+  }
 }
 
 template <typename TMesh, typename TForceImage>
@@ -1671,21 +1684,29 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
 {
   std::vector<double> & x = this->GetCoordinates();
   const SizeValueType   numberOfPoints = before.size() / 3;
-  // The input's triangles as sorted triples of point indices, sorted: a
-  // remeshed triangle whose points did not move and whose triple is one of
-  // these is the input's triangle, unchanged.
+  // The input's triangles as sorted triples of point indices, sorted (made
+  // when first needed): a remeshed triangle whose points did not move and
+  // whose triple of parents is one of these is the input's triangle,
+  // unchanged.
   using Triple = std::array<IndexType32, 3>;
   const auto sorted = [](IndexType32 a, IndexType32 b, IndexType32 c) {
     Triple t{ { a, b, c } };
     std::sort(t.begin(), t.end());
     return t;
   };
-  std::vector<Triple> inputTriangles(beforeTriangles.size() / 3);
-  for (SizeValueType t = 0; t < inputTriangles.size(); ++t)
-  {
-    inputTriangles[t] = sorted(beforeTriangles[3 * t], beforeTriangles[3 * t + 1], beforeTriangles[3 * t + 2]);
-  }
-  std::sort(inputTriangles.begin(), inputTriangles.end());
+  std::vector<Triple> inputTriangles;
+  const auto          isInputTriangle = [&](const Triple & triple) {
+    if (inputTriangles.empty())
+    {
+      inputTriangles.resize(beforeTriangles.size() / 3);
+      for (SizeValueType t = 0; t < inputTriangles.size(); ++t)
+      {
+        inputTriangles[t] = sorted(beforeTriangles[3 * t], beforeTriangles[3 * t + 1], beforeTriangles[3 * t + 2]);
+      }
+      std::sort(inputTriangles.begin(), inputTriangles.end());
+    }
+    return std::binary_search(inputTriangles.begin(), inputTriangles.end(), triple);
+  };
 
   std::vector<uint8_t> locked(numberOfPoints, 0);
   std::vector<uint8_t> changed;
@@ -1694,7 +1715,6 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
   for (;;)
   {
     const std::vector<IndexType32> & parents = m_Remesher.Parents();
-    const SizeValueType              remeshedPoints = parents.size();
     const SizeValueType              remeshedTriangles = m_Triangles.size() / 3;
     const auto                       moved = [&](IndexType32 v) {
       const IndexType32 p = parents[v];
@@ -1705,17 +1725,13 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
     {
       const IndexType32 * v = m_Triangles.data() + 3 * t;
       changed[t] = moved(v[0]) || moved(v[1]) || moved(v[2]) ||
-                   !std::binary_search(
-                     inputTriangles.begin(), inputTriangles.end(), sorted(parents[v[0]], parents[v[1]], parents[v[2]]));
+                   !isInputTriangle(sorted(parents[v[0]], parents[v[1]], parents[v[2]]));
     }
-    const SizeValueType found = SurfaceCollision::FindContacts(x.data(),
-                                                               m_Triangles.data(),
-                                                               remeshedTriangles,
-                                                               changed.data(),
-                                                               m_MinimumDistance,
-                                                               contacts,
-                                                               this->GetMultiThreader(),
-                                                               this->GetNumberOfWorkUnits());
+    // The collision test's surface and index for the remeshed mesh, built
+    // at its positions: the next step keeps the index.
+    m_Collision.SetSurface(parents.size(), m_Triangles.data(), remeshedTriangles);
+    const SizeValueType found = m_Collision.FindContacts(
+      x.data(), changed.data(), m_MinimumDistance, contacts, this->GetMultiThreader(), this->GetNumberOfWorkUnits());
     if (found == 0)
     {
       break;
@@ -1761,6 +1777,9 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
       static_cast<SizeValueType>(std::count(locked.begin(), locked.end(), uint8_t{ 1 }));
     if (!grew)
     {
+      // The collision test's surface for this output; the next step builds
+      // its index.
+      m_Collision.SetSurface(m_Remesher.Parents().size(), m_Triangles.data(), m_Triangles.size() / 3);
       break;
     }
   }

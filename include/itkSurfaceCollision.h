@@ -1095,6 +1095,34 @@ StoreBox(const double * lower, const double * upper, double margin, float * box)
     box[3 + k] = fhi;
   }
 }
+/** Runs body(begin, end) over [0, count) in blocks of 1024, on \a threader
+ * (may be null: in this thread) over \a workUnits units. */
+struct ParallelBlocks
+{
+  MultiThreaderBase * threader;
+  unsigned int        workUnits;
+
+  template <typename TBody>
+  void
+  operator()(SizeValueType count, TBody && body) const
+  {
+    constexpr SizeValueType block = 1024;
+    const SizeValueType     blocks = (count + block - 1) / block;
+    const auto              run = [&](SizeValueType b) { body(b * block, std::min(count, (b + 1) * block)); };
+    if (threader == nullptr || blocks < 2 || workUnits < 2)
+    {
+      for (SizeValueType b = 0; b < blocks; ++b)
+      {
+        run(b);
+      }
+    }
+    else
+    {
+      threader->SetNumberOfWorkUnits(workUnits);
+      threader->ParallelizeArray(0, blocks, run, nullptr);
+    }
+  }
+};
 } // namespace SurfaceCollisionDetail
 
 /** \class SurfaceCollision
@@ -1407,6 +1435,97 @@ public:
     return m_ContactDistance;
   }
 
+  /** Builds the index at the positions \a x (3 doubles a point, the
+   * current positions of the next Constrain(), which keeps the index) and
+   * finds the pairs in contact there: two triangles sharing no vertex closer
+   * than \a minimumDistance or intersecting (closer than the contact
+   * distance), and two triangles sharing one vertex whose gap
+   * (SharedVertexGap()) is below the contact distance (folded into each
+   * other). Only the pairs with at least one triangle flagged in \a changed
+   * (a byte per triangle; null: every triangle) count: a change of the
+   * surface (a remeshing) must not make contacts, those it did not touch may
+   * stay. Sets to 1 the flag of both triangles of each pair found in
+   * \a contacts (resized to the number of triangles) and returns the number
+   * of pairs. The index's candidate pairs hold every pair closer than its
+   * radius with a lower bound of its distance, so only pairs near contact
+   * are measured exactly. 0 and no flag when a coordinate is not finite. */
+  SizeValueType
+  FindContacts(const double *         x,
+               const uint8_t *        changed,
+               double                 minimumDistance,
+               std::vector<uint8_t> & contacts,
+               MultiThreaderBase *    threader,
+               unsigned int           workUnits)
+  {
+    const SizeValueType numberOfTriangles = this->GetNumberOfTriangles();
+    contacts.assign(numberOfTriangles, 0);
+    if (m_NumberOfPoints == 0 || numberOfTriangles < 2)
+    {
+      return 0;
+    }
+    if (m_Level.size() != m_NumberOfPoints)
+    {
+      m_Level.assign(m_NumberOfPoints, 0);
+    }
+    const SurfaceCollisionDetail::ParallelBlocks parallel{ threader, workUnits };
+    if (!this->Build(x, minimumDistance, parallel, false))
+    {
+      return 0;
+    }
+    const double                                              d = std::max(minimumDistance, m_ContactDistance);
+    const double                                              c = m_ContactDistance;
+    const SizeValueType                                       blocks = (numberOfTriangles + 1023) / 1024;
+    std::vector<std::vector<std::pair<IndexType, IndexType>>> found(blocks);
+    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+      auto & out = found[begin / 1024];
+      for (SizeValueType t = begin; t < end; ++t)
+      {
+        const bool        tChanged = changed == nullptr || changed[t] != 0;
+        const IndexType * vt = m_Triangles.data() + 3 * t;
+        const double *    a[3] = { x + 3 * vt[0], x + 3 * vt[1], x + 3 * vt[2] };
+        // Each pair from its lower triangle (both rows list it).
+        for (SizeValueType k = m_CandidateOffsets[t]; k < m_CandidateOffsets[t + 1]; ++k)
+        {
+          const IndexType u = m_Candidates[k];
+          if (u < t || !(tChanged || changed[u] != 0) || static_cast<double>(m_CandidateGaps[k]) >= d)
+          {
+            continue;
+          }
+          const IndexType * vu = m_Triangles.data() + 3 * u;
+          const double *    b[3] = { x + 3 * vu[0], x + 3 * vu[1], x + 3 * vu[2] };
+          if (!SurfaceCollisionDetail::SeparatedBy(a, b, d) && SurfaceCollisionDetail::TriangleDistance(a, b) < d)
+          {
+            out.emplace_back(static_cast<IndexType>(t), u);
+          }
+        }
+        for (IndexType k = m_SharedOffsets[t]; k < m_SharedOffsets[t + 1]; ++k)
+        {
+          const IndexType q = m_SharedOfTriangle[k];
+          const IndexType u = m_SharedPartner[k];
+          if (u < t || !(tChanged || changed[u] != 0) || static_cast<double>(m_SharedGaps[q]) >= c)
+          {
+            continue;
+          }
+          if (this->SharedGap(q, x) < c)
+          {
+            out.emplace_back(static_cast<IndexType>(t), u);
+          }
+        }
+      }
+    });
+    SizeValueType count = 0;
+    for (const auto & pairs : found)
+    {
+      for (const auto & pair : pairs)
+      {
+        contacts[pair.first] = 1;
+        contacts[pair.second] = 1;
+        ++count;
+      }
+    }
+    return count;
+  }
+
   /** Modifies the proposed positions \a y (3 doubles a point) so that no
    * pair of triangles sharing no vertex violates the constraint described
    * in the class documentation, given the current positions \a x, clear.
@@ -1434,23 +1553,7 @@ public:
     {
       m_IndexValid = false;
     }
-    const auto parallel = [threader, workUnits](SizeValueType count, auto && body) {
-      constexpr SizeValueType block = 1024;
-      const SizeValueType     blocks = (count + block - 1) / block;
-      const auto              run = [&](SizeValueType b) { body(b * block, std::min(count, (b + 1) * block)); };
-      if (threader == nullptr || blocks < 2 || workUnits < 2)
-      {
-        for (SizeValueType b = 0; b < blocks; ++b)
-        {
-          run(b);
-        }
-      }
-      else
-      {
-        threader->SetNumberOfWorkUnits(workUnits);
-        threader->ParallelizeArray(0, blocks, run, nullptr);
-      }
-    };
+    const SurfaceCollisionDetail::ParallelBlocks parallel{ threader, workUnits };
 
     // The bounds at y; when one fails the index is rebuilt at y (where
     // every displacement is zero and every bound holds).
@@ -1852,133 +1955,6 @@ public:
     if (first != nullptr)
     {
       *first = firstPair;
-    }
-    return count;
-  }
-
-  /** Finds the pairs of triangles in contact that a change of the surface
-   * (a remeshing) must not make: two triangles sharing no vertex that are
-   * closer than \a minimumDistance, or intersect (closer than the contact
-   * distance, 1e-6 of the mean edge length, as in Constrain()), and two
-   * triangles sharing exactly one vertex whose gap (SharedVertexGap()) is
-   * below the contact distance (folded into each other). Only the pairs
-   * with at least one triangle flagged in \a changed (a byte per triangle;
-   * null: every triangle) are tested. Sets to 1 the flag of both triangles
-   * of each pair found in \a contacts (resized to the number of triangles,
-   * zero elsewhere) and returns the number of pairs. \a threader (may be
-   * null) runs the tests over \a workUnits units. */
-  static SizeValueType
-  FindContacts(const double *         x,
-               const IndexType *      triangles,
-               SizeValueType          numberOfTriangles,
-               const uint8_t *        changed,
-               double                 minimumDistance,
-               std::vector<uint8_t> & contacts,
-               MultiThreaderBase *    threader = nullptr,
-               unsigned int           workUnits = 1)
-  {
-    using namespace SurfaceCollisionDetail;
-    contacts.assign(numberOfTriangles, 0);
-    if (numberOfTriangles < 2)
-    {
-      return 0;
-    }
-    double edges = 0.0;
-    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
-    {
-      const IndexType * v = triangles + 3 * t;
-      for (unsigned int k = 0; k < 3; ++k)
-      {
-        double e[3];
-        Subtract(x + 3 * v[k], x + 3 * v[(k + 1) % 3], e);
-        edges += std::sqrt(Dot(e, e));
-      }
-    }
-    const double       contact = 1e-6 * edges / static_cast<double>(3 * numberOfTriangles);
-    const double       d = std::max(minimumDistance, contact);
-    std::vector<float> boxes(6 * numberOfTriangles);
-    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
-    {
-      double lo[3], hi[3];
-      TriangleBox(x, triangles + 3 * t, lo, hi);
-      StoreBox(lo, hi, 0.5 * d, boxes.data() + 6 * t);
-    }
-    BoxGrid grid;
-    grid.Build(boxes.data(), numberOfTriangles);
-    constexpr SizeValueType                                   block = 1024;
-    const SizeValueType                                       blocks = (numberOfTriangles + block - 1) / block;
-    std::vector<std::vector<std::pair<IndexType, IndexType>>> found(blocks);
-    const auto                                                run = [&](SizeValueType b) {
-      auto &              out = found[b];
-      const SizeValueType end = std::min(numberOfTriangles, (b + 1) * block);
-      for (SizeValueType t = b * block; t < end; ++t)
-      {
-        if (changed != nullptr && changed[t] == 0)
-        {
-          continue;
-        }
-        const IndexType * vt = triangles + 3 * t;
-        const double *    a[3] = { x + 3 * vt[0], x + 3 * vt[1], x + 3 * vt[2] };
-        grid.ForEachOverlap(t, [&](SizeValueType u) {
-          // Each pair once: from its lower triangle when both changed.
-          if (u < t && (changed == nullptr || changed[u] != 0))
-          {
-            return;
-          }
-          const IndexType *  vu = triangles + 3 * u;
-          const double *     b[3] = { x + 3 * vu[0], x + 3 * vu[1], x + 3 * vu[2] };
-          const unsigned int shared = SharedVertices(vt, vu);
-          bool               found = false;
-          if (shared == 1)
-          {
-            unsigned int i = 0;
-            unsigned int j = 0;
-            for (unsigned int k = 0; k < 3; ++k)
-            {
-              for (unsigned int l = 0; l < 3; ++l)
-              {
-                if (vt[k] == vu[l])
-                {
-                  i = k;
-                  j = l;
-                }
-              }
-            }
-            found = SharedGapLowerBoundOf(vt, i, vu, j, x, contact) < contact && SharedVertexGap(a, i, b, j) < contact;
-          }
-          else if (shared == 0)
-          {
-            found = !SeparatedBy(a, b, d) && TriangleDistance(a, b) < d;
-          }
-          if (found)
-          {
-            out.emplace_back(static_cast<IndexType>(std::min<SizeValueType>(t, u)),
-                             static_cast<IndexType>(std::max<SizeValueType>(t, u)));
-          }
-        });
-      }
-    };
-    if (threader == nullptr || blocks < 2 || workUnits < 2)
-    {
-      for (SizeValueType b = 0; b < blocks; ++b)
-      {
-        run(b);
-      }
-    }
-    else
-    {
-      threader->SetNumberOfWorkUnits(workUnits);
-      threader->ParallelizeArray(0, blocks, run, nullptr);
-    }
-    SizeValueType count = 0;
-    for (const auto & pairs : found)
-    {
-      for (const auto & pair : pairs)
-      {
-        contacts[pair.first] = 1;
-        contacts[pair.second] = 1;
-        ++count;
-      }
     }
     return count;
   }
