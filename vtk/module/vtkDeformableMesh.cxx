@@ -139,6 +139,8 @@ vtkDeformableMesh::vtkDeformableMesh()
   this->MaximumStepLength = filter->GetMaximumStepLength();
   this->RemeshingEdgeLength = filter->GetRemeshingEdgeLength();
   this->RemeshingInterval = static_cast<int>(filter->GetRemeshingInterval());
+  this->ReferenceEdgeLength = filter->GetReferenceEdgeLength();
+  this->ConvergenceAlongNormals = filter->GetConvergenceAlongNormals() ? 1 : 0;
   this->PreventSelfIntersections = filter->GetPreventSelfIntersections() ? 1 : 0;
   this->MinimumDistance = filter->GetMinimumDistance();
   this->FixedBoundary = filter->GetFixedBoundary() ? 1 : 0;
@@ -429,6 +431,8 @@ vtkDeformableMesh::PrepareFilter(vtkInformationVector ** inputVector)
     filter->SetMaximumStepLength(this->MaximumStepLength);
     filter->SetRemeshingEdgeLength(this->RemeshingEdgeLength);
     filter->SetRemeshingInterval(static_cast<unsigned int>(this->RemeshingInterval));
+    filter->SetReferenceEdgeLength(this->ReferenceEdgeLength);
+    filter->SetConvergenceAlongNormals(this->ConvergenceAlongNormals != 0);
     filter->SetPreventSelfIntersections(this->PreventSelfIntersections != 0);
     filter->SetMinimumDistance(this->MinimumDistance);
     filter->SetFixedBoundary(this->FixedBoundary != 0);
@@ -507,6 +511,8 @@ vtkDeformableMesh::PrintSelf(ostream & os, vtkIndent indent)
   os << indent << "MaximumStepLength: " << this->MaximumStepLength << "\n";
   os << indent << "RemeshingEdgeLength: " << this->RemeshingEdgeLength << "\n";
   os << indent << "RemeshingInterval: " << this->RemeshingInterval << "\n";
+  os << indent << "ReferenceEdgeLength: " << this->ReferenceEdgeLength << "\n";
+  os << indent << "ConvergenceAlongNormals: " << (this->ConvergenceAlongNormals ? "On" : "Off") << "\n";
   os << indent << "PreventSelfIntersections: " << (this->PreventSelfIntersections ? "On" : "Off") << "\n";
   os << indent << "MinimumDistance: " << this->MinimumDistance << "\n";
   os << indent << "FixedBoundary: " << (this->FixedBoundary ? "On" : "Off") << "\n";

@@ -307,6 +307,20 @@ public:
 
   ///@{
   /**
+   * Reference edge length L: the edge length at which Elasticity and
+   * Rigidity have their nominal weight; when positive the internal forces
+   * are scaled by (L/h)^2 and (L/h)^4 (h the mesh's root mean square edge
+   * length), so the same parameters give the same surface at any resolution
+   * (with remeshing, typically RemeshingEdgeLength). 0: weights relative to
+   * the mesh's own edges. Millimetres, at least 0; default 0.
+   * Meaning in full: itk::DeformableMeshFilter::SetReferenceEdgeLength().
+   */
+  vtkSetClampMacro(ReferenceEdgeLength, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(ReferenceEdgeLength, double);
+  ///@}
+
+  ///@{
+  /**
    * No step lets the surface intersect itself: the displacements of the
    * vertices of triangles that would intersect, or come closer than
    * MinimumDistance, are halved, halved again, then zeroed; a remeshing that
@@ -376,6 +390,18 @@ public:
    */
   vtkSetClampMacro(ConvergenceFraction, double, 0.0, 1.0);
   vtkGetMacro(ConvergenceFraction, double);
+  ///@}
+
+  ///@{
+  /**
+   * The convergence test (tolerance, window, fraction) measures each
+   * vertex's displacement along its normal: vertices that only slide along
+   * the surface do not keep the model running. Default off.
+   * Meaning in full: itk::DeformableMeshFilter::SetConvergenceAlongNormals().
+   */
+  vtkSetMacro(ConvergenceAlongNormals, vtkTypeBool);
+  vtkGetMacro(ConvergenceAlongNormals, vtkTypeBool);
+  vtkBooleanMacro(ConvergenceAlongNormals, vtkTypeBool);
   ///@}
 
   ///@{
@@ -459,6 +485,8 @@ protected:
   vtkTypeBool EstimateObjectIntensityRange = 1;
   double      ObjectIntensityRange[2] = { 0.0, 1.0 };
   int         EdgePolarity = 0;
+  double      ReferenceEdgeLength = 0.0;
+  vtkTypeBool ConvergenceAlongNormals = 0;
   vtkTypeBool PreventSelfIntersections = 0;
   double      MinimumDistance = 0.0;
   vtkTypeBool FixedBoundary = 0;

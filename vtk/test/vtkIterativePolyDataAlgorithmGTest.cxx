@@ -798,6 +798,8 @@ TEST(VTKIterativeAlgorithms, PrintSelfPrintsEveryParameter)
                              "MaximumStepLength",
                              "RemeshingEdgeLength",
                              "RemeshingInterval",
+                             "ReferenceEdgeLength",
+                             "ConvergenceAlongNormals",
                              "PreventSelfIntersections",
                              "MinimumDistance",
                              "FixedBoundary",
@@ -1074,4 +1076,60 @@ TEST(VTKIterativeAlgorithms, PreventSelfIntersectionsGivesTheITKFiltersSurface)
     std::cout << (prevent ? "with" : "without") << " prevention: " << intersecting << " intersecting pairs, "
               << deformable->GetNumberOfCollisionsPrevented() << " near-collisions handled" << std::endl;
   }
+}
+
+TEST(VTKIterativeAlgorithms, ReferenceEdgeLengthAndConvergenceAlongNormalsGiveTheITKFiltersSurface)
+{
+  // The sphere of radius 11 (edges about 2.2 mm) onto the test ellipsoid
+  // with ReferenceEdgeLength 4 mm (internal forces scaled to the mesh's
+  // resolution, in sub-steps) and the
+  // convergence test along the normals: the VTK class runs the ITK filter
+  // with these settings, so the same surface bit for bit, the same number of
+  // iterations and the same sub-steps.
+  const auto                 forces = MakeForces();
+  auto                       forceImage = edm::ImageToImageData(forces.GetPointer(), "Force");
+  vtkNew<vtkTrivialProducer> producer;
+  producer->SetOutput(forceImage);
+  vtkNew<vtkSphereSource> source;
+  source->SetCenter(Center[0], Center[1], Center[2]);
+  source->SetRadius(11.0);
+  source->SetThetaResolution(32);
+  source->SetPhiResolution(32);
+  source->SetOutputPointsPrecision(vtkAlgorithm::DOUBLE_PRECISION);
+  source->Update();
+
+  vtkNew<vtkDeformableMesh> deformable;
+  deformable->SetInputConnection(0, source->GetOutputPort());
+  deformable->SetForceImageConnection(producer->GetOutputPort());
+  deformable->SetElasticity(0.2);
+  deformable->SetRigidity(0.05);
+  deformable->SetScaleFactor(0.5);
+  deformable->SetReferenceEdgeLength(4.0);
+  deformable->ConvergenceAlongNormalsOn();
+  deformable->SetConvergenceTolerance(0.01);
+  deformable->SetNumberOfIterations(400);
+  deformable->Update();
+
+  auto filter = itk::DeformableMeshFilter<MeshType, ForceImageType>::New();
+  filter->SetInput(ToITK(source->GetOutput()));
+  filter->SetForceImage(forces);
+  filter->SetElasticity(0.2);
+  filter->SetRigidity(0.05);
+  filter->SetScaleFactor(0.5);
+  filter->SetReferenceEdgeLength(4.0);
+  filter->SetConvergenceAlongNormals(true);
+  filter->SetConvergenceTolerance(0.01);
+  filter->SetNumberOfIterations(400);
+  filter->Update();
+  EXPECT_GT(filter->GetNumberOfSubSteps(), 1u) << "edges shorter than L: the internal forces in sub-steps";
+  EXPECT_TRUE(filter->GetConverged());
+  EXPECT_EQ(deformable->GetConverged(), 1);
+  EXPECT_EQ(deformable->GetCurrentIteration(), static_cast<int>(filter->GetCurrentIteration()));
+  EXPECT_EQ(Coordinates(deformable->GetOutput()), Coordinates(filter->GetOutput()));
+
+  // Without the reference length (the weights relative to the mesh's own
+  // edges) the surface differs.
+  deformable->SetReferenceEdgeLength(0.0);
+  deformable->Update();
+  EXPECT_NE(Coordinates(deformable->GetOutput()), Coordinates(filter->GetOutput()));
 }
