@@ -2429,19 +2429,6 @@ private:
     unsigned int      i = 0;
     unsigned int      j = 0;
     this->SharedCorners(q, vt, vu, i, j);
-    return SharedGapLowerBoundOf(vt, i, vu, j, x, enough);
-  }
-
-  /** SharedGapLowerBound() of the triangles \a vt and \a vu (3 point
-   * indices each), which share the point vt[i] == vu[j]. */
-  static double
-  SharedGapLowerBoundOf(const IndexType * vt,
-                        unsigned int      i,
-                        const IndexType * vu,
-                        unsigned int      j,
-                        const double *    x,
-                        double            enough)
-  {
     using namespace SurfaceCollisionDetail;
     const double * v = x + 3 * vt[i];
     double         p[3], q1[3], r[3], s[3];
