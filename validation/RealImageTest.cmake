@@ -1,6 +1,7 @@
 # Segments a real scan with edmodel's defaults and scores the surface against
-# a reference segmentation (edmScore): fails when edmodel fails or when the
-# Dice or the mean boundary distance misses its limit.
+# a reference segmentation (edmScore): fails when edmodel fails, when the
+# surface intersects itself, or when the Dice or the mean boundary distance
+# misses its limit.
 # -DEDMODEL= -DSCORE= -DIMAGE= -DREFERENCE= -DSPHERE=X,Y,Z,R -DOUTPUT= -DMIN_DICE= -DMAX_MEAN=
 file(REMOVE "${OUTPUT}")
 execute_process(COMMAND ${EDMODEL} segment --image ${IMAGE} --init-sphere ${SPHERE} --output ${OUTPUT}
@@ -8,6 +9,11 @@ execute_process(COMMAND ${EDMODEL} segment --image ${IMAGE} --init-sphere ${SPHE
 message(STATUS "${err}${out}")
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "edmodel exited with ${rc}")
+endif()
+# The defaults keep the surface from intersecting itself (ch2bet without the
+# test: 70 intersecting pairs of triangles).
+if(NOT out MATCHES "surface quality: 0 intersecting pairs of triangles")
+  message(FATAL_ERROR "the surface intersects itself, or edmodel gave no quality summary")
 endif()
 execute_process(COMMAND ${SCORE} score ${OUTPUT} ${REFERENCE} --min-dice ${MIN_DICE} --max-mean ${MAX_MEAN}
   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)

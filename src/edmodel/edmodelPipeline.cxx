@@ -384,7 +384,8 @@ Deform(const ImageType *        image,
     deform->SetIntensityImage(image);
     ConfigureLevel(deform.GetPointer(), o, schedule, state, stage, last, MeanEdgeLength(stageInput));
     deform->SetPreventSelfIntersections(o.preventSelfIntersections);
-    deform->SetMinimumDistance(o.minimumDistance);
+    deform->SetMinimumDistance(
+      o.minimumDistance >= 0.0 ? o.minimumDistance : defaults::MinimumDistanceOverEdgeLength * schedule.edgeLength);
     RunLevel(deform.GetPointer(),
              o,
              schedule,
@@ -497,6 +498,16 @@ RunSegment(const SegmentOptions & o, const GlobalOptions & global)
   {
     initial = ReadMesh(o.initMesh, "--init-mesh");
     CheckInitialMesh(image, initial, o.initMesh, progress);
+    if (o.preventSelfIntersections)
+    {
+      const auto intersections = itk::SurfaceCollision::CountSelfIntersections(initial.GetPointer());
+      if (intersections > 0)
+      {
+        throw Error("--init-mesh: mesh '" + o.initMesh + "' intersects itself (" + std::to_string(intersections) +
+                    " pairs of triangles sharing no vertex intersect); repair it, or pass "
+                    "--allow-self-intersections");
+      }
+    }
   }
   else
   {

@@ -45,6 +45,11 @@ endif()
 if(NOT EXISTS "${output}")
   message(FATAL_ERROR "no output mesh ${output}")
 endif()
+# Surfaces never intersect themselves unless --allow-self-intersections.
+if(out MATCHES "surface quality: ([0-9]+) intersecting pairs" AND NOT "--allow-self-intersections" IN_LIST arguments
+   AND NOT CMAKE_MATCH_1 EQUAL 0)
+  message(FATAL_ERROR "the surface intersects itself: ${CMAKE_MATCH_1} pairs of triangles")
+endif()
 edm_check_no_leftovers()
 
 edm_expand(present "${PRESENT}")

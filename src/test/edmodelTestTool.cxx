@@ -251,7 +251,21 @@ WriteSphere(const std::string & path, const std::map<std::string, std::string> &
   }
   const unsigned int resolution =
     options.count("--resolution") ? static_cast<unsigned int>(std::stoi(options.at("--resolution"))) : 3;
-  auto mesh = itk::MakeSphereMesh<MeshType>(center, Numbers(options, "--radius", 1)[0], resolution);
+  const double radius = Numbers(options, "--radius", 1)[0];
+  auto         mesh = itk::MakeSphereMesh<MeshType>(center, radius, resolution);
+  if (options.count("--fold"))
+  {
+    // Point 0 pushed through the sphere to 1.5 radii beyond the centre on
+    // the other side: its triangles cross those around the antipode, a
+    // surface that intersects itself.
+    const auto p = mesh->GetPoint(0);
+    auto       q = p;
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      q[k] = center[k] - 1.5 * (p[k] - center[k]);
+    }
+    mesh->SetPoint(0, q);
+  }
   auto writer = itk::MeshFileWriter<MeshType>::New();
   writer->SetInput(mesh);
   writer->SetFileName(path);
