@@ -987,7 +987,11 @@ DeformableMeshFilter<TMesh, TForceImage>::ResetCollision(const std::vector<uint3
     triangles = &extracted;
   }
   const SizeValueType numberOfTriangles = triangles->size() / 3;
-  m_Collision.SetSurface(this->GetNumberOfCachedPoints(), triangles->data(), numberOfTriangles);
+  m_Collision.SetSurface(this->GetNumberOfCachedPoints(),
+                         triangles->data(),
+                         numberOfTriangles,
+                         this->GetMultiThreader(),
+                         this->GetNumberOfWorkUnits());
   if (!check)
   {
     return;
@@ -1729,7 +1733,8 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
     }
     // The collision test's surface and index for the remeshed mesh, built
     // at its positions: the next step keeps the index.
-    m_Collision.SetSurface(parents.size(), m_Triangles.data(), remeshedTriangles);
+    m_Collision.SetSurface(
+      parents.size(), m_Triangles.data(), remeshedTriangles, this->GetMultiThreader(), this->GetNumberOfWorkUnits());
     const SizeValueType found = m_Collision.FindContacts(
       x.data(), changed.data(), m_MinimumDistance, contacts, this->GetMultiThreader(), this->GetNumberOfWorkUnits());
     if (found == 0)
@@ -1779,7 +1784,11 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
     {
       // The collision test's surface for this output; the next step builds
       // its index.
-      m_Collision.SetSurface(m_Remesher.Parents().size(), m_Triangles.data(), m_Triangles.size() / 3);
+      m_Collision.SetSurface(m_Remesher.Parents().size(),
+                             m_Triangles.data(),
+                             m_Triangles.size() / 3,
+                             this->GetMultiThreader(),
+                             this->GetNumberOfWorkUnits());
       break;
     }
   }

@@ -23,6 +23,7 @@
 #include "itkMultiThreaderBase.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -1229,6 +1230,25 @@ struct ParallelBlocks
  * (a uniform grid built for that step) comes within d of theirs: every
  * state that the reductions make lies in those boxes.
  *
+ * A certificate without pairs, for a minimum distance of 0: when the
+ * surface is closed (every edge in exactly two triangles, in opposite
+ * directions) and, seen from the centroid c of its points at y, every
+ * triangle has the same strict orientation and a generic ray from c crosses
+ * exactly one triangle, the central projection from c onto a sphere is
+ * one-to-one (IsStarShaped()): its degree is the number of crossings of any
+ * ray that meets no edge, every point of the sphere is covered once, so no
+ * two points of the surface coincide. No pair intersects and no fan folds,
+ * and y is kept without the index (which the next step that needs it
+ * rebuilds). Two exact orientation signs per triangle, and three more for
+ * the few triangles near the ray: a balloon inflating inside a convex or
+ * star-shaped object costs a pass over the points and one over the
+ * triangles per step. Only the contact distance (1e-6 of the mean edge) is
+ * not measured: the index would hold two triangles that come closer than
+ * that without touching, the certificate does not. After a step it does not
+ * certify, it is tried again after 1, 2, 4, ... up to 64 steps, so that a
+ * surface that is not star-shaped pays for it on at most one step in 64.
+ * SetUseStarShapedCertificate(false) turns it off.
+ *
  * CountSelfIntersections() counts the intersecting pairs of a surface with
  * a grid of exact triangle boxes.
  *
@@ -1281,7 +1301,11 @@ public:
    * Constrain() builds it. Call again whenever the mesh changes (remeshing,
    * renumbering). */
   void
-  SetSurface(SizeValueType numberOfPoints, const IndexType * triangles, SizeValueType numberOfTriangles)
+  SetSurface(SizeValueType       numberOfPoints,
+             const IndexType *   triangles,
+             SizeValueType       numberOfTriangles,
+             MultiThreaderBase * threader = nullptr,
+             unsigned int        workUnits = 1)
   {
     m_NumberOfPoints = numberOfPoints;
     m_Triangles.assign(triangles, triangles + 3 * numberOfTriangles);
@@ -1289,40 +1313,123 @@ public:
     GroupsOfKeys(m_Triangles, 3, numberOfPoints, m_VertexTriangleOffsets, m_VertexTriangles);
     // The pairs sharing exactly one vertex (in one fan, not across an
     // edge): each once, t < u, and per triangle the pairs it is in.
-    m_SharedPairs.clear();
-    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
-    {
-      const IndexType * vt = m_Triangles.data() + 3 * t;
-      for (unsigned int k = 0; k < 3; ++k)
+    // In the same pass, whether the surface is closed (IsClosedSurface()):
+    // each directed edge (a, b) of a triangle is in no other triangle of a's
+    // in that direction and in exactly one in the other.
+    // In blocks of triangles (in parallel with a threader), concatenated in
+    // order: the same list as one pass.
+    const SurfaceCollisionDetail::ParallelBlocks parallel{ threader, workUnits };
+    constexpr SizeValueType                      block = 1024;
+    std::vector<std::vector<IndexType>>          blockPairs((numberOfTriangles + block - 1) / block);
+    std::vector<uint8_t>                         blockClosed(blockPairs.size(), 1);
+    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+      auto & pairs = blockPairs[begin / block];
+      bool   closed = true;
+      for (SizeValueType t = begin; t < end; ++t)
       {
-        for (SizeValueType f = m_VertexTriangleOffsets[vt[k]]; f < m_VertexTriangleOffsets[vt[k] + 1]; ++f)
+        const IndexType * vt = m_Triangles.data() + 3 * t;
+        for (unsigned int k = 0; k < 3; ++k)
         {
-          const IndexType u = m_VertexTriangles[f];
-          if (u > t && SharedVertices(vt, m_Triangles.data() + 3 * u) == 1)
+          const IndexType a = vt[k];
+          const IndexType b = vt[(k + 1) % 3];
+          unsigned int    forward = 0;
+          unsigned int    backward = 0;
+          for (SizeValueType f = m_VertexTriangleOffsets[a]; f < m_VertexTriangleOffsets[a + 1]; ++f)
           {
-            m_SharedPairs.push_back(static_cast<IndexType>(t));
-            m_SharedPairs.push_back(u);
+            const IndexType   u = m_VertexTriangles[f];
+            const IndexType * vu = m_Triangles.data() + 3 * u;
+            for (unsigned int j = 0; j < 3; ++j)
+            {
+              forward += vu[j] == a && vu[(j + 1) % 3] == b ? 1 : 0;
+              backward += vu[j] == b && vu[(j + 1) % 3] == a ? 1 : 0;
+            }
+            if (u > t && SharedVertices(vt, vu) == 1)
+            {
+              pairs.push_back(static_cast<IndexType>(t));
+              pairs.push_back(u);
+            }
           }
+          closed = closed && a != b && forward == 1 && backward == 1;
         }
       }
+      blockClosed[begin / block] = closed ? 1 : 0;
+    });
+    m_SharedPairs.clear();
+    bool closed = numberOfTriangles >= 4;
+    for (SizeValueType b = 0; b < blockPairs.size(); ++b)
+    {
+      m_SharedPairs.insert(m_SharedPairs.end(), blockPairs[b].begin(), blockPairs[b].end());
+      closed = closed && blockClosed[b] != 0;
     }
     const SizeValueType numberOfSharedPairs = m_SharedPairs.size() / 2;
     GroupsOfKeys(m_SharedPairs, 2, numberOfTriangles, m_SharedOffsets, m_SharedOfTriangle);
     // The other triangle of each entry, read at every step without a visit
     // to the pair.
     m_SharedPartner.resize(m_SharedOfTriangle.size());
-    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
-    {
-      for (IndexType k = m_SharedOffsets[t]; k < m_SharedOffsets[t + 1]; ++k)
+    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+      for (SizeValueType t = begin; t < end; ++t)
       {
-        m_SharedPartner[k] = this->OtherOfShared(m_SharedOfTriangle[k], t);
+        for (IndexType k = m_SharedOffsets[t]; k < m_SharedOffsets[t + 1]; ++k)
+        {
+          m_SharedPartner[k] = this->OtherOfShared(m_SharedOfTriangle[k], t);
+        }
       }
-    }
+    });
     m_SharedGaps.assign(numberOfSharedPairs, 0.0f);
     m_SharedExact.assign(numberOfSharedPairs, 0);
     m_SharedComputed.assign(numberOfSharedPairs, 0.0f);
+    m_Closed = closed;
+    m_CertificateWait = 0;
+    m_CertificateBackoff = 0;
     m_HasSurface = true;
     this->Invalidate();
+  }
+
+  /** Whether Constrain() and FindContacts() may accept positions by the
+   * star-shaped certificate (class documentation) when the minimum distance
+   * is 0. On by default; off, every step goes through the index. */
+  void
+  SetUseStarShapedCertificate(bool use)
+  {
+    m_UseStarCertificate = use;
+  }
+  bool
+  GetUseStarShapedCertificate() const
+  {
+    return m_UseStarCertificate;
+  }
+
+  /** Steps (and remeshings checked by FindContacts()) accepted by the
+   * star-shaped certificate since SetSurface(). */
+  SizeValueType
+  GetNumberOfCertifiedSteps() const
+  {
+    return m_NumberOfCertifiedSteps;
+  }
+
+  /** True when SetSurface()'s triangles form a closed surface: every
+   * directed edge (a, b) of a triangle is the edge (b, a) of exactly one
+   * other triangle and of no other triangle in the same direction, and no
+   * triangle repeats a point. */
+  bool
+  IsClosedSurface() const
+  {
+    return m_Closed;
+  }
+
+  /** The certificate (class documentation): true when the surface set by
+   * SetSurface() is closed and, at the positions \a x (3 doubles a point),
+   * every triangle seen from the centroid of the points has the same
+   * strict orientation (exact signs) and a ray from the centroid crosses
+   * exactly one triangle, none on its boundary. Then no two triangles
+   * intersect and no two triangles of a fan fold into each other. False
+   * when in doubt (a coordinate not finite, a zero sign, a ray through an
+   * edge). */
+  bool
+  IsStarShaped(const double * x, MultiThreaderBase * threader = nullptr, unsigned int workUnits = 1) const
+  {
+    const SurfaceCollisionDetail::ParallelBlocks parallel{ threader, workUnits };
+    return this->StarShaped(x, parallel);
   }
 
   /** Forgets the connectivity and the index. */
@@ -1468,6 +1575,10 @@ public:
       m_Level.assign(m_NumberOfPoints, 0);
     }
     const SurfaceCollisionDetail::ParallelBlocks parallel{ threader, workUnits };
+    if (this->Certify(x, minimumDistance, parallel))
+    {
+      return 0;
+    }
     if (!this->Build(x, minimumDistance, parallel, false))
     {
       return 0;
@@ -1554,6 +1665,11 @@ public:
       m_IndexValid = false;
     }
     const SurfaceCollisionDetail::ParallelBlocks parallel{ threader, workUnits };
+    if (this->Certify(y, minimumDistance, parallel))
+    {
+      m_NumberOfDeferredTriangles = 0;
+      return result;
+    }
 
     // The bounds at y; when one fails the index is rebuilt at y (where
     // every displacement is zero and every bound holds).
@@ -2575,6 +2691,156 @@ private:
   }
 
   /** m as a float not above it. */
+  /** Constrain()'s and FindContacts()'s use of the certificate: true when
+   * the positions \a y are accepted without the index (which is then
+   * dropped); after a failure the next tries wait 1, 2, 4, ... 64 calls. */
+  template <typename TParallel>
+  bool
+  Certify(const double * y, double minimumDistance, TParallel && parallel)
+  {
+    if (!m_UseStarCertificate || !m_Closed || minimumDistance != 0.0)
+    {
+      return false;
+    }
+    if (m_CertificateWait > 0)
+    {
+      --m_CertificateWait;
+      return false;
+    }
+    if (this->StarShaped(y, parallel))
+    {
+      m_CertificateBackoff = 0;
+      ++m_NumberOfCertifiedSteps;
+      m_IndexValid = false;
+      return true;
+    }
+    m_CertificateBackoff = std::min<unsigned int>(64, std::max<unsigned int>(1, 2 * m_CertificateBackoff));
+    m_CertificateWait = m_CertificateBackoff;
+    return false;
+  }
+
+  /** IsStarShaped(), with the passes run by \a parallel. */
+  template <typename TParallel>
+  bool
+  StarShaped(const double * x, TParallel && parallel) const
+  {
+    const SizeValueType n = m_NumberOfPoints;
+    const SizeValueType numberOfTriangles = this->GetNumberOfTriangles();
+    if (!m_Closed || n == 0)
+    {
+      return false;
+    }
+    // The centroid, and the largest coordinate magnitude (the scale of the
+    // rounding of the ray's screen below).
+    constexpr SizeValueType            block = 1024;
+    std::vector<std::array<double, 4>> partial((n + block - 1) / block);
+    parallel(n, [&](SizeValueType begin, SizeValueType end) {
+      std::array<double, 4> p{ { 0.0, 0.0, 0.0, 0.0 } };
+      for (SizeValueType i = begin; i < end; ++i)
+      {
+        for (unsigned int k = 0; k < 3; ++k)
+        {
+          p[k] += x[3 * i + k];
+          p[3] = std::max(p[3], std::abs(x[3 * i + k]));
+        }
+      }
+      partial[begin / block] = p;
+    });
+    double sum[3] = { 0.0, 0.0, 0.0 };
+    double scale = 0.0;
+    for (const auto & p : partial)
+    {
+      sum[0] += p[0];
+      sum[1] += p[1];
+      sum[2] += p[2];
+      scale = std::max(scale, p[3]);
+    }
+    const double centre[3] = { sum[0] / static_cast<double>(n),
+                               sum[1] / static_cast<double>(n),
+                               sum[2] / static_cast<double>(n) };
+    if (!(std::isfinite(centre[0]) && std::isfinite(centre[1]) && std::isfinite(centre[2]) && std::isfinite(scale)))
+    {
+      return false;
+    }
+    // A ray in a direction of no symmetry of the usual meshes, and two unit
+    // vectors orthogonal to it: a triangle whose three points lie strictly
+    // on one side of the ray's line along either of them (with a margin far
+    // above the rounding of these products) cannot meet the line.
+    const double ray[3] = { 0.8017837257372732, 0.4454354031873740, 0.3984095364447979 };
+    const double e1[3] = { -0.4856429311786321, 0.8741572761215377, 0.0 };
+    const double e2[3] = { ray[1] * e1[2] - ray[2] * e1[1],
+                           ray[2] * e1[0] - ray[0] * e1[2],
+                           ray[0] * e1[1] - ray[1] * e1[0] };
+    const double margin = 1e-9 * (scale + 1e-300);
+    // A point on the ray as far out as the coordinates, so that its
+    // rounding turns the ray by about 1e-16 at most.
+    const double length = scale + 1.0;
+    const double target[3] = { centre[0] + length * ray[0], centre[1] + length * ray[1], centre[2] + length * ray[2] };
+    const SizeValueType blocks = (numberOfTriangles + block - 1) / block;
+    // Per block: positive and negative orientations, ray crossings, and
+    // whether a sign was zero.
+    std::vector<std::array<SizeValueType, 4>> counts(blocks, std::array<SizeValueType, 4>{ { 0, 0, 0, 0 } });
+    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+      auto & c = counts[begin / block];
+      for (SizeValueType t = begin; t < end; ++t)
+      {
+        const IndexType * vt = m_Triangles.data() + 3 * t;
+        const double *    a = x + 3 * vt[0];
+        const double *    b = x + 3 * vt[1];
+        const double *    e = x + 3 * vt[2];
+        const int         orientation = SurfaceCollisionDetail::Orient3DSign(centre, a, b, e);
+        if (orientation == 0)
+        {
+          ++c[3];
+          continue;
+        }
+        ++c[orientation > 0 ? 0 : 1];
+        double         p1[3];
+        double         p2[3];
+        const double * v[3] = { a, b, e };
+        for (unsigned int k = 0; k < 3; ++k)
+        {
+          const double q[3] = { v[k][0] - centre[0], v[k][1] - centre[1], v[k][2] - centre[2] };
+          p1[k] = q[0] * e1[0] + q[1] * e1[1] + q[2] * e1[2];
+          p2[k] = q[0] * e2[0] + q[1] * e2[1] + q[2] * e2[2];
+        }
+        if (std::min({ p1[0], p1[1], p1[2] }) > margin || std::max({ p1[0], p1[1], p1[2] }) < -margin ||
+            std::min({ p2[0], p2[1], p2[2] }) > margin || std::max({ p2[0], p2[1], p2[2] }) < -margin)
+        {
+          continue;
+        }
+        // The ray's direction in the cone of the triangle seen from the
+        // centre: its three coordinates in the cone's edges (Cramer) have
+        // the sign of the orientation.
+        const int s1 = SurfaceCollisionDetail::Orient3DSign(centre, target, b, e);
+        const int s2 = SurfaceCollisionDetail::Orient3DSign(centre, a, target, e);
+        const int s3 = SurfaceCollisionDetail::Orient3DSign(centre, a, b, target);
+        if (s1 == orientation && s2 == orientation && s3 == orientation)
+        {
+          ++c[2];
+        }
+        else if ((s1 == 0 || s1 == orientation) && (s2 == 0 || s2 == orientation) && (s3 == 0 || s3 == orientation))
+        {
+          ++c[3]; // the ray meets an edge or a point of the triangle
+        }
+      }
+    });
+    SizeValueType positive = 0;
+    SizeValueType negative = 0;
+    SizeValueType crossings = 0;
+    for (const auto & c : counts)
+    {
+      if (c[3] > 0)
+      {
+        return false;
+      }
+      positive += c[0];
+      negative += c[1];
+      crossings += c[2];
+    }
+    return (positive == 0 || negative == 0) && crossings == 1;
+  }
+
   static float
   RoundDown(double m)
   {
@@ -3575,6 +3841,12 @@ private:
   std::vector<float>         m_SharedGaps;       // per shared pair: a lower bound of its gap at the reference
   std::vector<uint8_t>       m_SharedExact;      // per shared pair: the bound is the exact gap
   std::vector<float>         m_SharedComputed;   // per shared pair: its bound when last computed (not carried)
+
+  bool          m_Closed{ false }; // IsClosedSurface()
+  bool          m_UseStarCertificate{ true };
+  SizeValueType m_NumberOfCertifiedSteps{ 0 };
+  unsigned int  m_CertificateWait{ 0 };    // calls to skip before the next try
+  unsigned int  m_CertificateBackoff{ 0 }; // the last wait
 
   // The index (see the class documentation).
   bool                            m_IndexValid{ false };

@@ -810,6 +810,206 @@ TEST(SurfaceCollision, ConstrainStopsFrontsPushedThroughEachOther)
 
 namespace
 {
+/** A sphere of radius 5 (resolution 3: 258 points) off the origin, flat. */
+void
+StarSphere(std::vector<double> & x, std::vector<uint32_t> & triangles, double radius = 5.0)
+{
+  MeshType::PointType centre;
+  centre[0] = 1.3;
+  centre[1] = -0.7;
+  centre[2] = 2.1;
+  Flatten(itk::MakeSphereMesh<MeshType>(centre, radius, 3), x, triangles);
+}
+
+/** y = x with every point moved along its direction from the sphere's
+ * centre by \a grow times a smooth factor in [0.5, 1.5] that changes with
+ * \a step: a star-shaped surface stays star-shaped. */
+std::vector<double>
+Inflate(const std::vector<double> & x, double grow, unsigned int step)
+{
+  std::vector<double> y = x;
+  for (std::size_t i = 0; i < x.size() / 3; ++i)
+  {
+    const double d[3] = { x[3 * i] - 1.3, x[3 * i + 1] + 0.7, x[3 * i + 2] - 2.1 };
+    const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    const double f = 1.0 + 0.5 * std::sin(0.7 * d[0] + 0.3 * step) * std::cos(0.5 * d[2]);
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      y[3 * i + k] += grow * f * d[k] / r;
+    }
+  }
+  return y;
+}
+} // namespace
+
+TEST(SurfaceCollision, TheStarShapedCertificateKnowsItsSurfaces)
+{
+  std::vector<double>   x;
+  std::vector<uint32_t> triangles;
+  StarSphere(x, triangles);
+  const std::size_t     n = x.size() / 3;
+  itk::SurfaceCollision collision;
+  collision.SetSurface(n, triangles.data(), triangles.size() / 3);
+  EXPECT_TRUE(collision.IsClosedSurface());
+  EXPECT_TRUE(collision.IsStarShaped(x.data()));
+  // Bumped but star-shaped; the same with the triangles turned inward.
+  const std::vector<double> bumped = Inflate(x, 2.0, 0);
+  EXPECT_TRUE(collision.IsStarShaped(bumped.data()));
+  std::vector<uint32_t> inward = triangles;
+  for (std::size_t t = 0; t < inward.size() / 3; ++t)
+  {
+    std::swap(inward[3 * t + 1], inward[3 * t + 2]);
+  }
+  itk::SurfaceCollision turned;
+  turned.SetSurface(n, inward.data(), inward.size() / 3);
+  EXPECT_TRUE(turned.IsStarShaped(bumped.data()));
+
+  // Point 0 pushed through the sphere: intersecting, not certified.
+  std::vector<double> folded = x;
+  for (unsigned int k = 0; k < 3; ++k)
+  {
+    const double centre = k == 0 ? 1.3 : (k == 1 ? -0.7 : 2.1);
+    folded[k] = centre - 1.5 * (x[k] - centre);
+  }
+  ASSERT_GT(CheckAllPairs(folded, triangles, 0.0).intersecting, 0u);
+  EXPECT_FALSE(collision.IsStarShaped(folded.data()));
+  // Point 0 pulled sideways until one of its triangles turns its back to
+  // the centre, without intersecting: not star-shaped from the centroid,
+  // not certified (the index decides).
+  std::vector<double> leaning = x;
+  leaning[0] += 4.0;
+  leaning[1] += 4.0;
+  EXPECT_FALSE(collision.IsStarShaped(leaning.data()));
+
+  // Two spheres, one inside the other, both turned outward: every triangle
+  // faces away from the centre, but a ray crosses two: not certified.
+  std::vector<double>   inner;
+  std::vector<uint32_t> innerTriangles;
+  StarSphere(inner, innerTriangles, 3.0);
+  std::vector<double>   nested = x;
+  std::vector<uint32_t> nestedTriangles = triangles;
+  nested.insert(nested.end(), inner.begin(), inner.end());
+  for (const uint32_t v : innerTriangles)
+  {
+    nestedTriangles.push_back(static_cast<uint32_t>(v + n));
+  }
+  itk::SurfaceCollision two;
+  two.SetSurface(nested.size() / 3, nestedTriangles.data(), nestedTriangles.size() / 3);
+  EXPECT_TRUE(two.IsClosedSurface());
+  EXPECT_FALSE(two.IsStarShaped(nested.data()));
+
+  // Open surfaces, and a closed one with a triangle turned over, are not
+  // closed in the certificate's sense.
+  std::vector<double>   sheets;
+  std::vector<uint32_t> sheetTriangles;
+  TwoSheets(1.0, sheets, sheetTriangles);
+  itk::SurfaceCollision open;
+  open.SetSurface(sheets.size() / 3, sheetTriangles.data(), sheetTriangles.size() / 3);
+  EXPECT_FALSE(open.IsClosedSurface());
+  EXPECT_FALSE(open.IsStarShaped(sheets.data()));
+  std::vector<uint32_t> oneTurned = triangles;
+  std::swap(oneTurned[1], oneTurned[2]);
+  itk::SurfaceCollision mixed;
+  mixed.SetSurface(n, oneTurned.data(), oneTurned.size() / 3);
+  EXPECT_FALSE(mixed.IsClosedSurface());
+  EXPECT_FALSE(mixed.IsStarShaped(x.data()));
+}
+
+TEST(SurfaceCollision, CertifiedStepsGiveWhatTheIndexGives)
+{
+  // A sphere inflating unevenly (star-shaped at every step), then deflating
+  // through its centre (its fronts meet there), with minimum distance 0:
+  // with the certificate and without, the same positions at every step, no
+  // intersecting pair (all-pairs test); with it the inflating steps need no
+  // index. With a minimum distance above 0 the certificate is not used.
+  std::vector<double>   x;
+  std::vector<uint32_t> triangles;
+  StarSphere(x, triangles);
+  const std::size_t     n = x.size() / 3;
+  itk::SurfaceCollision certified;
+  itk::SurfaceCollision indexed;
+  certified.SetSurface(n, triangles.data(), triangles.size() / 3);
+  indexed.SetSurface(n, triangles.data(), triangles.size() / 3);
+  indexed.SetUseStarShapedCertificate(false);
+  std::vector<double> a = x;
+  std::vector<double> b = x;
+  unsigned int        constrained = 0;
+  for (unsigned int step = 0; step < 20; ++step)
+  {
+    // Out for 10 steps, then in by 1.2 a step, through the centre.
+    const double        grow = step < 10 ? 0.4 : -1.2;
+    std::vector<double> ya = Inflate(a, grow, step);
+    std::vector<double> yb = Inflate(b, grow, step);
+    ASSERT_EQ(ya, yb);
+    const auto ra = certified.Constrain(a.data(), ya.data(), 0.0, nullptr, 1);
+    const auto rb = indexed.Constrain(b.data(), yb.data(), 0.0, nullptr, 1);
+    ASSERT_EQ(ya, yb) << "step " << step;
+    EXPECT_EQ(ra.constrained, rb.constrained) << "step " << step;
+    EXPECT_EQ(CheckAllPairs(ya, triangles, 0.0).intersecting, 0u) << "step " << step;
+    if (step == 9)
+    {
+      EXPECT_EQ(certified.GetNumberOfCertifiedSteps(), 10u) << "every inflating step";
+      EXPECT_EQ(certified.GetNumberOfRebuilds(), 0u);
+      EXPECT_GE(indexed.GetNumberOfRebuilds(), 1u);
+    }
+    constrained += rb.constrained > 0 ? 1 : 0;
+    a = ya;
+    b = yb;
+  }
+  EXPECT_GE(constrained, 5u) << "the fronts met";
+  EXPECT_EQ(indexed.GetNumberOfCertifiedSteps(), 0u);
+
+  // A minimum distance above 0: the index.
+  itk::SurfaceCollision withDistance;
+  withDistance.SetSurface(n, triangles.data(), triangles.size() / 3);
+  std::vector<double> y = Inflate(x, 0.4, 0);
+  withDistance.Constrain(x.data(), y.data(), 0.05, nullptr, 1);
+  EXPECT_EQ(withDistance.GetNumberOfCertifiedSteps(), 0u);
+  EXPECT_EQ(withDistance.GetNumberOfRebuilds(), 1u);
+}
+
+TEST(SurfaceCollision, AfterAFailureTheCertificateWaitsLongerEachTime)
+{
+  // A step that is not star-shaped (a point pulled sideways), then
+  // star-shaped steps: the certificate is not tried at the next 1, then
+  // after a second failure the next 2 calls; a success resets the wait.
+  std::vector<double>   x;
+  std::vector<uint32_t> triangles;
+  StarSphere(x, triangles);
+  itk::SurfaceCollision collision;
+  collision.SetSurface(x.size() / 3, triangles.data(), triangles.size() / 3);
+  const auto step = [&](bool leaning) {
+    std::vector<double> y = x;
+    if (leaning)
+    {
+      y[0] += 4.0;
+      y[1] += 4.0;
+    }
+    const itk::SizeValueType before = collision.GetNumberOfCertifiedSteps();
+    collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1);
+    return collision.GetNumberOfCertifiedSteps() > before;
+  };
+  EXPECT_TRUE(step(false));
+  EXPECT_FALSE(step(true));
+  EXPECT_FALSE(step(false)) << "waits 1";
+  EXPECT_TRUE(step(false));
+  EXPECT_FALSE(step(true));
+  EXPECT_FALSE(step(false)) << "waits 1 (the success reset the wait)";
+  EXPECT_FALSE(step(true));
+  EXPECT_FALSE(step(false)) << "waits 2";
+  EXPECT_FALSE(step(false)) << "waits 2";
+  EXPECT_TRUE(step(false));
+  // FindContacts() on a star-shaped surface at distance 0: no contact, by
+  // the certificate.
+  std::vector<uint8_t>     contacts;
+  const itk::SizeValueType before = collision.GetNumberOfCertifiedSteps();
+  EXPECT_EQ(collision.FindContacts(x.data(), nullptr, 0.0, contacts, nullptr, 1), 0u);
+  EXPECT_EQ(collision.GetNumberOfCertifiedSteps(), before + 1);
+  EXPECT_EQ(contacts.size(), triangles.size() / 3);
+}
+
+namespace
+{
 /** Statistics of RandomSteps(). */
 struct RandomStepsResult
 {

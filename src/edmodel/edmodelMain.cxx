@@ -382,7 +382,7 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
     { model,
       "--allow-self-intersections",
       "",
-      "turn the self-intersection test off: faster (a third to a half of the time on a brain MRI), "
+      "turn the self-intersection test off: faster (a fifth to a half of the time on a brain MRI), "
       "but parts of the surface may pass through each other where fronts meet",
       std::string(defaults::PreventSelfIntersections ? "intersections prevented" : "allowed") + " on 3-D surfaces",
       [&o](const std::string &) {

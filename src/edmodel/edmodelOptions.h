@@ -90,8 +90,8 @@ constexpr double ConvergenceFraction = 0.005;
  * onto each other in the interhemispheric fissure (smallest angle 0.13
  * degrees, 24 triangles under 1 degree); with 0.05 with none and a smallest
  * angle of 2.57 degrees (0.1: 3.57 degrees, a third slower). Dice and mean
- * distance the same to 4 digits in all four; about 3 times the time on
- * ch2bet, 2 on ch2. */
+ * distance the same to 4 digits in all four; 4 to 5 times the time on
+ * ch2bet (6.5 to 7.4 s against 1.4 to 1.7 s), 2.3 on ch2. */
 constexpr bool   PreventSelfIntersections = true;
 constexpr double MinimumDistanceOverEdgeLength = 0.05;
 /** Subdivisions of the octahedron of --init-sphere (4 * 4^n + 2 points). */
