@@ -149,14 +149,13 @@ TwoDifference(double b, double a, double & hi, double & lo)
   lo = (b - av) + (bv - a);
 }
 
-/** Sign of Orient3D(a, b, c, d), exact. */
+/** The floating-point filter of Orient3DSign(): the sign of the
+ * determinant of the rounded differences ab = b - a, ac = c - a, ad = d - a
+ * when its error bound decides it, else 0 (undecided; also for values that
+ * are not finite). */
 inline int
-Orient3DSign(const double * a, const double * b, const double * c, const double * d)
+Orient3DFilteredSign(const double * ab, const double * ac, const double * ad)
 {
-  double ab[3], ac[3], ad[3];
-  Subtract(b, a, ab);
-  Subtract(c, a, ac);
-  Subtract(d, a, ad);
   const double m0 = ab[1] * ac[2] - ab[2] * ac[1];
   const double m1 = ab[2] * ac[0] - ab[0] * ac[2];
   const double m2 = ab[0] * ac[1] - ab[1] * ac[0];
@@ -166,14 +165,26 @@ Orient3DSign(const double * a, const double * b, const double * c, const double 
                            (std::abs(ab[0] * ac[1]) + std::abs(ab[1] * ac[0])) * std::abs(ad[2]);
   // (7 + 56 eps) eps bounds the error of this evaluation; 1e-15 > 7.8e-16.
   const double bound = 1e-15 * permanent;
-  if (det > bound)
+  return det > bound ? 1 : (det < -bound ? -1 : 0);
+}
+
+/** Sign of Orient3D(a, b, c, d), exact. */
+inline int
+Orient3DSign(const double * a, const double * b, const double * c, const double * d)
+{
+  double ab[3], ac[3], ad[3];
+  Subtract(b, a, ab);
+  Subtract(c, a, ac);
+  Subtract(d, a, ad);
+  const int filtered = Orient3DFilteredSign(ab, ac, ad);
+  if (filtered != 0)
   {
-    return 1;
+    return filtered;
   }
-  if (det < -bound)
-  {
-    return -1;
-  }
+  const double m0 = ab[1] * ac[2] - ab[2] * ac[1];
+  const double m1 = ab[2] * ac[0] - ab[0] * ac[2];
+  const double m2 = ab[0] * ac[1] - ab[1] * ac[0];
+  const double det = m0 * ad[0] + m1 * ad[1] + m2 * ad[2];
   if (!std::isfinite(det))
   {
     return det > 0.0 ? 1 : (det < 0.0 ? -1 : 0);
@@ -1239,7 +1250,7 @@ struct ParallelBlocks
  * ray that meets no edge, every point of the sphere is covered once, so no
  * two points of the surface coincide. No pair intersects and no fan folds,
  * and y is kept without the index (which the next step that needs it
- * rebuilds). Two exact orientation signs per triangle, and three more for
+ * rebuilds). One exact orientation sign per triangle, and three more for
  * the few triangles near the ray: a balloon inflating inside a convex or
  * star-shaped object costs a pass over the points and one over the
  * triangles per step. Only the contact distance (1e-6 of the mean edge) is
@@ -2386,13 +2397,21 @@ private:
     {
       return;
     }
-    this->EnsureReferenceGrid();
-    const SizeValueType visited = this->ForEachGridPartner(t, globalMotion, d, [&](SizeValueType u) {
-      if (m_IsLarge[t] || m_IsLarge[u] || m_IsDeferred[t] || m_IsDeferred[u])
-      {
-        f(u);
-      }
-    });
+    SizeValueType visited = 0;
+    if (m_IsLarge[t] || m_IsDeferred[t])
+    {
+      this->EnsureReferenceGrid();
+      visited = this->ForEachGridPartner(t, globalMotion, d, f);
+    }
+    else
+    {
+      // Only the large and deferred triangles: the grid of their boxes
+      // alone (a triangle that is neither queried the grid of every box,
+      // and visited hundreds of boxes to find a few of them where a wide
+      // contact held thousands of points at every step).
+      this->EnsureSpecialGrid();
+      visited = this->ForEachGridPartner(t, globalMotion, d, f, m_SpecialGrid, m_SpecialTriangles.data());
+    }
     if (!m_Deferred.empty())
     {
       m_DeferredWork += visited;
@@ -2425,6 +2444,20 @@ private:
   SizeValueType
   ForEachGridPartner(SizeValueType t, double motion, double d, TFunction && f) const
   {
+    return this->ForEachGridPartner(t, motion, d, f, m_ReferenceGrid, nullptr);
+  }
+
+  /** The same over \a grid, a grid of the reference boxes of the triangles
+   * \a ids (null: of every triangle, entry u is triangle u). */
+  template <typename TFunction>
+  SizeValueType
+  ForEachGridPartner(SizeValueType                           t,
+                     double                                  motion,
+                     double                                  d,
+                     TFunction &&                            f,
+                     const SurfaceCollisionDetail::BoxGrid & grid,
+                     const IndexType *                       ids) const
+  {
     SizeValueType visited = 0;
     const float * bt = m_TriangleDelta.data() + 6 * t;
     double        lo[3], hi[3];
@@ -2432,7 +2465,13 @@ private:
     float query[6];
     SurfaceCollisionDetail::StoreBox(lo, hi, motion + d, query);
     const double * st = m_Spheres.data() + 4 * t;
-    m_ReferenceGrid.ForEachOverlapOfBox(query, t, [&](SizeValueType u) {
+    const auto     none = std::numeric_limits<SizeValueType>::max();
+    grid.ForEachOverlapOfBox(query, ids == nullptr ? t : none, [&](SizeValueType entry) {
+      const SizeValueType u = ids == nullptr ? entry : ids[entry];
+      if (u == t)
+      {
+        return;
+      }
       ++visited;
       if (SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
       {
@@ -2461,6 +2500,32 @@ private:
       m_ReferenceGrid.Build(m_ReferenceBoxes.data(), this->GetNumberOfTriangles());
       m_ReferenceGridBuilt = true;
     }
+  }
+
+  /** Builds the grid of the reference boxes of the large and the deferred
+   * triangles if this step has not built it yet (Bound() drops it). */
+  void
+  EnsureSpecialGrid()
+  {
+    if (m_SpecialGridBuilt)
+    {
+      return;
+    }
+    m_SpecialTriangles.assign(m_Large.begin(), m_Large.end());
+    for (const IndexType t : m_Deferred)
+    {
+      if (!m_IsLarge[t])
+      {
+        m_SpecialTriangles.push_back(t);
+      }
+    }
+    m_SpecialBoxes.resize(6 * m_SpecialTriangles.size());
+    for (SizeValueType k = 0; k < m_SpecialTriangles.size(); ++k)
+    {
+      std::copy_n(m_ReferenceBoxes.data() + 6 * m_SpecialTriangles[k], 6, m_SpecialBoxes.data() + 6 * k);
+    }
+    m_SpecialGrid.Build(m_SpecialBoxes.data(), m_SpecialTriangles.size());
+    m_SpecialGridBuilt = true;
   }
 
   /** Candidate c of triangle t may violate when the relative motion of the
@@ -2788,21 +2853,28 @@ private:
         const double *    a = x + 3 * vt[0];
         const double *    b = x + 3 * vt[1];
         const double *    e = x + 3 * vt[2];
-        const int         orientation = SurfaceCollisionDetail::Orient3DSign(centre, a, b, e);
+        // The differences as Orient3DSign(centre, a, b, e) rounds them.
+        double q[3][3];
+        SurfaceCollisionDetail::Subtract(a, centre, q[0]);
+        SurfaceCollisionDetail::Subtract(b, centre, q[1]);
+        SurfaceCollisionDetail::Subtract(e, centre, q[2]);
+        int orientation = SurfaceCollisionDetail::Orient3DFilteredSign(q[0], q[1], q[2]);
+        if (orientation == 0)
+        {
+          orientation = SurfaceCollisionDetail::Orient3DSign(centre, a, b, e);
+        }
         if (orientation == 0)
         {
           ++c[3];
           continue;
         }
         ++c[orientation > 0 ? 0 : 1];
-        double         p1[3];
-        double         p2[3];
-        const double * v[3] = { a, b, e };
+        double p1[3];
+        double p2[3];
         for (unsigned int k = 0; k < 3; ++k)
         {
-          const double q[3] = { v[k][0] - centre[0], v[k][1] - centre[1], v[k][2] - centre[2] };
-          p1[k] = q[0] * e1[0] + q[1] * e1[1] + q[2] * e1[2];
-          p2[k] = q[0] * e2[0] + q[1] * e2[1] + q[2] * e2[2];
+          p1[k] = q[k][0] * e1[0] + q[k][1] * e1[1] + q[k][2] * e1[2];
+          p2[k] = q[k][0] * e2[0] + q[k][1] * e2[1] + q[k][2] * e2[2];
         }
         if (std::min({ p1[0], p1[1], p1[2] }) > margin || std::max({ p1[0], p1[1], p1[2] }) < -margin ||
             std::min({ p2[0], p2[1], p2[2] }) > margin || std::max({ p2[0], p2[1], p2[2] }) < -margin)
@@ -3445,6 +3517,7 @@ private:
     m_Active.assign(numberOfTriangles, 0);
     m_IsDeferred.assign(numberOfTriangles, 0);
     m_Deferred.clear();
+    m_SpecialGridBuilt = false;
     m_DeferredSum = 0;
     m_DeferredWork = 0;
     m_IndexValid = true;
@@ -3633,6 +3706,7 @@ private:
     {
       m_Deferred.insert(m_Deferred.end(), block.begin(), block.end());
     }
+    m_SpecialGridBuilt = false;
     const SizeValueType numberOfTriangles = this->GetNumberOfTriangles();
     if (x == nullptr)
     {
@@ -3871,6 +3945,10 @@ private:
   std::vector<float>              m_ReferenceBoxes; // per triangle at the reference, widened by R/2
   SurfaceCollisionDetail::BoxGrid m_ReferenceGrid;  // built when a step needs it (EnsureReferenceGrid())
   bool                            m_ReferenceGridBuilt{ false };
+  std::vector<IndexType>          m_SpecialTriangles; // the large and the deferred triangles (EnsureSpecialGrid())
+  std::vector<float>              m_SpecialBoxes;     // their boxes at the reference
+  SurfaceCollisionDetail::BoxGrid m_SpecialGrid;
+  bool                            m_SpecialGridBuilt{ false };
   std::vector<float>              m_CellClearance;
 
   // Per step.
