@@ -1406,7 +1406,7 @@ RunSegmentContour(const SegmentOptions & o, const GlobalOptions & global)
     }
     CheckOutputDirectoryOf(o.overlayPng, "--overlay-png");
   }
-  if (o.preventSelfIntersectionsGiven)
+  if (o.preventSelfIntersections)
   {
     throw Error("--prevent-self-intersections works on the triangles of surfaces, not on 2-D contours");
   }

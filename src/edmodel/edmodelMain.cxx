@@ -372,28 +372,16 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                 "",
                 "no step lets the surface intersect itself or bring two triangles sharing no vertex closer than "
                 "--minimum-distance: the displacements of the vertices of colliding triangles are halved, then "
-                "zeroed; an --init-mesh that intersects itself is an error (3-D surfaces only)",
-                std::string(defaults::PreventSelfIntersections ? "on" : "off") + " for 3-D surfaces",
-                [&o](const std::string &) {
-                  o.preventSelfIntersections = true;
-                  o.preventSelfIntersectionsGiven = true;
-                } });
-  t.push_back(
-    { model,
-      "--allow-self-intersections",
-      "",
-      "turn the self-intersection test off: faster (a fifth to a half of the time on a brain MRI), "
-      "but parts of the surface may pass through each other where fronts meet",
-      std::string(defaults::PreventSelfIntersections ? "intersections prevented" : "allowed") + " on 3-D surfaces",
-      [&o](const std::string &) {
-        o.preventSelfIntersections = false;
-        o.preventSelfIntersectionsGiven = false;
-      } });
+                "zeroed; an --init-mesh that intersects itself is an error (3-D surfaces only; slower, much slower "
+                "where the surface is pressed against itself over a wide area)",
+                defaults::PreventSelfIntersections ? "on" : "off",
+                [&o](const std::string &) { o.preventSelfIntersections = true; } });
   t.push_back({ model,
                 "--minimum-distance",
                 "MM",
-                "the smallest distance a step may leave between two triangles sharing no vertex, physical units "
-                "(mm); 0 only keeps them from intersecting; keep it below half the shortest edge",
+                "with --prevent-self-intersections, the smallest distance a step may leave between two triangles "
+                "sharing no vertex, physical units (mm); 0 only keeps them from intersecting; keep it below half "
+                "the shortest edge",
                 FormatNumber(defaults::MinimumDistanceOverEdgeLength) + " x --edge-length",
                 [&o](const std::string & s) {
                   o.minimumDistance = ParseDouble("--minimum-distance", s);

@@ -80,19 +80,22 @@ constexpr double       ConvergenceTolerance = 0.02;
 /** A level is quiet when at most this fraction of its vertices move by the
  * tolerance or more (the filter's ConvergenceFraction). */
 constexpr double ConvergenceFraction = 0.005;
-/** 3-D surfaces never intersect themselves (the filter's
- * PreventSelfIntersections; --allow-self-intersections turns it off), and no
+/** --prevent-self-intersections (the filter's PreventSelfIntersections) is
+ * off by default: it keeps the surface from intersecting itself, but where
+ * a wide contact holds thousands of points at every iteration it is slow.
+ * On ch2bet from the validation's sphere (2026-12-05) it costs 6 s against
+ * 1.5 to 2 s, but with --sigma 2 260 s and with --region 0.125 65 s (the
+ * 65 538-point level pressed into the interhemispheric fissure: 2 000 to
+ * 2 800 points held and an index rebuild at every iteration). With it, no
  * step leaves two triangles sharing no vertex closer than
- * MinimumDistanceOverEdgeLength times --edge-length (0.05 mm on a 1 mm grid).
- * On ch2bet from the validation's sphere (2026-12-05): without the test the
- * surface ended with 70 intersecting pairs of triangles (smallest angle 2.21
- * degrees); with it and a distance of 0 with none, but with fronts pressed
- * onto each other in the interhemispheric fissure (smallest angle 0.13
- * degrees, 24 triangles under 1 degree); with 0.05 with none and a smallest
- * angle of 2.57 degrees (0.1: 3.57 degrees, a third slower). Dice and mean
- * distance the same to 4 digits in all four; 4 to 5 times the time on
- * ch2bet (6.5 to 7.4 s against 1.4 to 1.7 s), 2.3 on ch2. */
-constexpr bool   PreventSelfIntersections = true;
+ * MinimumDistanceOverEdgeLength times --edge-length (0.05 mm on a 1 mm
+ * grid): without the test ch2bet ends with 70 intersecting pairs of
+ * triangles (smallest angle 2.21 degrees); with it and a distance of 0 with
+ * none, but with the fronts pressed onto each other (smallest angle 0.13
+ * degrees, 24 triangles under 1 degree); with 0.05 with none and 2.57
+ * degrees (0.1: 3.57 degrees, a third slower). Dice and mean distance the
+ * same to 4 digits in all four. */
+constexpr bool   PreventSelfIntersections = false;
 constexpr double MinimumDistanceOverEdgeLength = 0.05;
 /** Subdivisions of the octahedron of --init-sphere (4 * 4^n + 2 points). */
 constexpr unsigned int SphereResolution = 4;
@@ -226,7 +229,6 @@ struct SegmentOptions
   double balloon{ GetCoreDefaults().Balloon };
   double regionWeight{ -1.0 }; // negative: defaults::RegionWeightInVoxels times the smallest spacing
   bool   preventSelfIntersections{ defaults::PreventSelfIntersections };
-  bool   preventSelfIntersectionsGiven{ false }; // an error on 2-D contours (edmodelContour.cxx)
   double minimumDistance{ -1.0 };    // negative: defaults::MinimumDistanceOverEdgeLength times the edge length
   double edgeSearchWeight{ -1.0 };   // negative: defaults::EdgeSearchWeightInVoxels times the smallest spacing
   double edgeSearchDistance{ -1.0 }; // non-positive: defaults::EdgeSearchDistanceInVoxels times the smallest spacing

@@ -260,7 +260,7 @@ TEST(ParameterDefaults, AgreeInTheITKAndVTKClassesThePluginAndTheCommandLine)
                 static_cast<double>(itkModel->GetPreventSelfIntersections()),
                 static_cast<double>(vtkModel->GetPreventSelfIntersections()),
                 "--prevent-self-intersections",
-                "on for 3-D surfaces" },
+                "off" },
     { "MinimumDistance",
                 itkModel->GetMinimumDistance(),
                 vtkModel->GetMinimumDistance(),
