@@ -2001,36 +2001,69 @@ public:
       std::sort(triangles.begin(), triangles.end());
       triangles.erase(std::unique(triangles.begin(), triangles.end()), triangles.end());
       violating.clear();
-      for (const IndexType t : triangles)
+      // The grids the queries below need, built first: the tests then only
+      // read, and run in parallel over blocks of triangles (their pairs
+      // gathered in block order).
+      if (sweptBounded && !(m_Large.empty() && m_Deferred.empty()))
       {
-        const auto test = [&](SizeValueType u) {
-          if (this->Violates(t, u, x, y, d))
+        bool needAll = false;
+        bool needSpecial = false;
+        for (const IndexType t : triangles)
+        {
+          if (!(LargestDistance(m_TriangleDelta.data() + 6 * t, m_GlobalDelta) < m_Radius - d))
           {
-            violating.emplace_back(std::min<IndexType>(t, static_cast<IndexType>(u)),
-                                   std::max<IndexType>(t, static_cast<IndexType>(u)));
+            (m_IsLarge[t] || m_IsDeferred[t] ? needAll : needSpecial) = true;
           }
-        };
-        if (sweptBounded)
-        {
-          this->ForEachBoundedPartner(t, d, test);
         }
-        else
+        if (needAll)
         {
-          m_SweptGrid.ForEachOverlap(t, [&](SizeValueType u) {
-            if (!SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
+          this->EnsureReferenceGrid();
+        }
+        if (needSpecial)
+        {
+          this->EnsureSpecialGrid();
+        }
+      }
+      const SizeValueType                                       roundBlocks = (triangles.size() + 1023) / 1024;
+      std::vector<std::vector<std::pair<IndexType, IndexType>>> roundFound(roundBlocks);
+      parallel(triangles.size(), [&](SizeValueType begin, SizeValueType end) {
+        auto & out = roundFound[begin / 1024];
+        for (SizeValueType k = begin; k < end; ++k)
+        {
+          const IndexType t = triangles[k];
+          const auto      test = [&](SizeValueType u) {
+            if (this->Violates(t, u, x, y, d))
             {
-              test(u);
+              out.emplace_back(std::min<IndexType>(t, static_cast<IndexType>(u)),
+                               std::max<IndexType>(t, static_cast<IndexType>(u)));
             }
-          });
-        }
-        for (IndexType k = m_SharedOffsets[t]; k < m_SharedOffsets[t + 1]; ++k)
-        {
-          const IndexType q = m_SharedOfTriangle[k];
-          if (this->ViolatesShared(q, x, y, m_ContactDistance))
+          };
+          if (sweptBounded)
           {
-            violating.emplace_back(m_SharedPairs[2 * q], m_SharedPairs[2 * q + 1]);
+            this->ForEachBoundedPartner(t, d, test);
+          }
+          else
+          {
+            m_SweptGrid.ForEachOverlap(t, [&](SizeValueType u) {
+              if (!SurfaceCollisionDetail::ShareVertex(m_Triangles.data() + 3 * t, m_Triangles.data() + 3 * u))
+              {
+                test(u);
+              }
+            });
+          }
+          for (IndexType j = m_SharedOffsets[t]; j < m_SharedOffsets[t + 1]; ++j)
+          {
+            const IndexType q = m_SharedOfTriangle[j];
+            if (this->ViolatesShared(q, x, y, m_ContactDistance))
+            {
+              out.emplace_back(m_SharedPairs[2 * q], m_SharedPairs[2 * q + 1]);
+            }
           }
         }
+      });
+      for (const auto & block : roundFound)
+      {
+        violating.insert(violating.end(), block.begin(), block.end());
       }
     }
     for (const IndexType i : m_ModifiedPoints)
@@ -2412,10 +2445,11 @@ private:
       this->EnsureSpecialGrid();
       visited = this->ForEachGridPartner(t, globalMotion, d, f, m_SpecialGrid, m_SpecialTriangles.data());
     }
-    if (!m_Deferred.empty())
-    {
-      m_DeferredWork += visited;
-    }
+    // (The visits are not counted in the deferral budget: that budget
+    // bounds the deferred triangles' own queries in the tested pass; the
+    // halving loop's queries exhausted it at every step of a wide contact,
+    // and every step rebuilt the index.)
+    (void)visited;
   }
 
   /** A bound of the motion of deferred triangle t against every triangle
