@@ -1668,7 +1668,8 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
   this->FindBoundaryVertices(m_Triangles);
   // The collision test's tables for the new mesh (no check: see
   // ResetCollision()); with PreventSelfIntersections RemeshWithoutContacts()
-  // has set them and built the index at these positions.
+  // has set them and built the index at these positions (or certified the
+  // surface without one: SurfaceCollision::IsStarShaped()).
   if (m_PreventSelfIntersections && m_Collision.HasSurface() && m_Collision.GetNumberOfPoints() == newNumberOfPoints)
   {
     m_CollisionTriangles = m_Triangles;

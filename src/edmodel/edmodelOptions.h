@@ -83,10 +83,11 @@ constexpr double ConvergenceFraction = 0.005;
 /** --prevent-self-intersections (the filter's PreventSelfIntersections) is
  * off by default: it keeps the surface from intersecting itself, but where
  * a wide contact holds thousands of points at every iteration it is slow.
- * On ch2bet from the validation's sphere (2026-12-05) it costs 6 s against
- * 1.5 to 2 s, but with --sigma 2 260 s and with --region 0.125 65 s (the
- * 65 538-point level pressed into the interhemispheric fissure: 2 000 to
- * 2 800 points held and an index rebuild at every iteration). With it, no
+ * On ch2bet from the validation's sphere (2026-12-05) it costs 6 to 7 s
+ * against 1.5 to 2 s, but with --sigma 2 144 s (260 s before the halving
+ * loop ran in parallel) and with --region 0.125 65 s (the 65 538-point
+ * level pressed into the interhemispheric fissure: 1 500 to 2 800 points
+ * held at every iteration, docs/performance.md). With it, no
  * step leaves two triangles sharing no vertex closer than
  * MinimumDistanceOverEdgeLength times --edge-length (0.05 mm on a 1 mm
  * grid): without the test ch2bet ends with 70 intersecting pairs of
