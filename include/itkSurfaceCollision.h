@@ -2430,11 +2430,14 @@ private:
     {
       return;
     }
-    SizeValueType visited = 0;
+    // (The visits are not counted in the deferral budget: that budget
+    // bounds the deferred triangles' own queries in the tested pass; the
+    // halving loop's queries exhausted it at every step of a wide contact,
+    // and every step rebuilt the index.)
     if (m_IsLarge[t] || m_IsDeferred[t])
     {
       this->EnsureReferenceGrid();
-      visited = this->ForEachGridPartner(t, globalMotion, d, f);
+      this->ForEachGridPartner(t, globalMotion, d, f);
     }
     else
     {
@@ -2443,13 +2446,8 @@ private:
       // and visited hundreds of boxes to find a few of them where a wide
       // contact held thousands of points at every step).
       this->EnsureSpecialGrid();
-      visited = this->ForEachGridPartner(t, globalMotion, d, f, m_SpecialGrid, m_SpecialTriangles.data());
+      this->ForEachGridPartner(t, globalMotion, d, f, m_SpecialGrid, m_SpecialTriangles.data());
     }
-    // (The visits are not counted in the deferral budget: that budget
-    // bounds the deferred triangles' own queries in the tested pass; the
-    // halving loop's queries exhausted it at every step of a wide contact,
-    // and every step rebuilt the index.)
-    (void)visited;
   }
 
   /** A bound of the motion of deferred triangle t against every triangle
@@ -2789,7 +2787,6 @@ private:
     return next < SurfaceCollisionDetail::TriangleDistance(a0, b0);
   }
 
-  /** m as a float not above it. */
   /** Constrain()'s and FindContacts()'s use of the certificate: true when
    * the positions \a y are accepted without the index (which is then
    * dropped); after a failure the next tries wait 1, 2, 4, ... 64 calls. */
@@ -2947,6 +2944,7 @@ private:
     return (positive == 0 || negative == 0) && crossings == 1;
   }
 
+  /** m as a float not above it. */
   static float
   RoundDown(double m)
   {
