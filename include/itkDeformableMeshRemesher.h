@@ -315,18 +315,21 @@ private:
   Relax();
   /** Moves the end-points of each edge still shorter than the minimum apart
    * along it, when no other edge of theirs leaves the band and no triangle
-   * turns around. */
+   * turns around; failing that, when their other edges all stay longer than
+   * this edge was (and no longer than the maximum). */
   void
   LengthenPass();
   /** Whether moving free vertex \a v, of neighbours \a ring and corners
    * \a corners (Ring()), to \a q keeps its edges other than the one to
-   * \a other within the band and turns none of its triangles around. */
+   * \a other no longer than the maximum and no shorter than \a floor2
+   * (squared), and turns none of its triangles around. */
   bool
   MoveKeepsBand(IndexType                      v,
                 const double *                 q,
                 IndexType                      other,
                 const std::vector<IndexType> & ring,
-                const std::vector<IndexType> & corners) const;
+                const std::vector<IndexType> & corners,
+                double                         floor2) const;
   /** Runs body(begin, end) over [0, n) in blocks of \a blockSize, on the
    * threader if any. */
   template <typename TBody>
@@ -1290,9 +1293,12 @@ DeformableMeshRemesher::Relax()
 {
   const std::size_t     numberOfPoints = m_State.size();
   std::vector<double> & moved = m_Moved;
-  moved.assign(m_X.begin(), m_X.end());
+  moved.resize(m_X.size());
   std::atomic<std::size_t> relaxed{ 0 };
   this->ParallelFor(numberOfPoints, [&](std::size_t first, std::size_t last) {
+    // The block's positions as they are (in parallel: the copy of a large
+    // mesh costs as much as a relaxation's arithmetic).
+    std::copy(m_X.begin() + 3 * first, m_X.begin() + 3 * last, moved.begin() + 3 * first);
     std::vector<IndexType> ring; // per block
     std::vector<IndexType> corners;
     std::vector<double>    normals; // of the vertex's triangles, as they are
@@ -1378,7 +1384,8 @@ DeformableMeshRemesher::MoveKeepsBand(IndexType                      v,
                                       const double *                 q,
                                       IndexType                      other,
                                       const std::vector<IndexType> & ring,
-                                      const std::vector<IndexType> & corners) const
+                                      const std::vector<IndexType> & corners,
+                                      double                         floor2) const
 {
   for (const IndexType w : ring)
   {
@@ -1388,7 +1395,7 @@ DeformableMeshRemesher::MoveKeepsBand(IndexType                      v,
     }
     const double * p = m_X.data() + 3 * static_cast<std::size_t>(w);
     const double   d2 = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]);
-    if (d2 < m_Min2 || d2 > m_Max2)
+    if (!(d2 >= floor2) || d2 > m_Max2)
     {
       return false;
     }
@@ -1417,9 +1424,10 @@ inline void
 DeformableMeshRemesher::LengthenPass()
 {
   const double minimum = std::sqrt(m_Min2);
-  // The moves keep every other edge of the two end-points within the band:
-  // no edge becomes short during the pass, so the short edges of the mesh
-  // before it are all there is to visit.
+  // The short edges of the mesh before the pass are all it visits. A move
+  // that keeps the other edges of the two end-points within the band makes
+  // no edge short; the fallback move may shorten one below the minimum, but
+  // never to the length of the edge it lengthens: the shortest edge grows.
   const auto shortEdge = [this](IndexType c) {
     if (m_V[c] == Invalid || m_O[c] < static_cast<int64_t>(c))
     {
@@ -1454,22 +1462,28 @@ DeformableMeshRemesher::LengthenPass()
       }
       return walked[which] == 1;
     };
+    // First within the band; failing that, a move that leaves every other
+    // edge of the two longer than this one is now: the shortest edge around
+    // grows (a short edge hemmed in by edges just above the minimum).
     const double shares[3][2] = { { 0.5, 0.5 }, { 1.0, 0.0 }, { 0.0, 1.0 } };
-    for (const auto & share : shares)
+    for (const double floor2 : { m_Min2, length2 * 1.0001 })
     {
-      double qa[3];
-      double qb[3];
-      for (unsigned int d = 0; d < 3; ++d)
+      for (const auto & share : shares)
       {
-        qa[d] = pa[d] - share[0] * missing * u[d];
-        qb[d] = pb[d] + share[1] * missing * u[d];
-      }
-      if ((share[0] == 0.0 || (movable(0) && this->MoveKeepsBand(a, qa, b, m_RingA, m_CornersA))) &&
-          (share[1] == 0.0 || (movable(1) && this->MoveKeepsBand(b, qb, a, m_RingB, m_CornersB))))
-      {
-        std::copy(qa, qa + 3, pa);
-        std::copy(qb, qb + 3, pb);
-        break;
+        double qa[3];
+        double qb[3];
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          qa[d] = pa[d] - share[0] * missing * u[d];
+          qb[d] = pb[d] + share[1] * missing * u[d];
+        }
+        if ((share[0] == 0.0 || (movable(0) && this->MoveKeepsBand(a, qa, b, m_RingA, m_CornersA, floor2))) &&
+            (share[1] == 0.0 || (movable(1) && this->MoveKeepsBand(b, qb, a, m_RingB, m_CornersB, floor2))))
+        {
+          std::copy(qa, qa + 3, pa);
+          std::copy(qb, qb + 3, pb);
+          return;
+        }
       }
     }
   });
@@ -1549,46 +1563,71 @@ DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<I
     m_State.swap(state);
     m_Valence.swap(valence);
 
-    // The corner table in the new numbering: the remaining triangles in
-    // their order (an increasing map, so that each edge keeps the corner it
-    // is listed from).
+    // The corner table in the new numbering: the remaining triangles
+    // ordered by their smallest new vertex (a stable counting sort), so that
+    // the corners of a fan sit near each other in memory as the vertices
+    // do. In the order of the table, the triangles that splits appended
+    // would lie far from their neighbours, in the order of their edge
+    // lengths.
     std::vector<IndexType> & newCorner = m_NewCorner;
     newCorner.assign(numberOfCorners, Invalid);
-    IndexType next = 0;
+    start.assign(static_cast<std::size_t>(kept) + 1, 0);
+    const auto smallest = [&](std::size_t c) {
+      return std::min({ newIndex[m_V[c]], newIndex[m_V[c + 1]], newIndex[m_V[c + 2]] });
+    };
     for (std::size_t c = 0; c < numberOfCorners; c += 3)
     {
       if (m_V[c] != Invalid)
       {
-        newCorner[c] = next;
-        newCorner[c + 1] = next + 1;
-        newCorner[c + 2] = next + 2;
-        next += 3;
+        ++start[smallest(c) + 1];
+      }
+    }
+    for (std::size_t i = 0; i < kept; ++i)
+    {
+      start[i + 1] += start[i];
+    }
+    const IndexType next = 3 * start[kept];
+    for (std::size_t c = 0; c < numberOfCorners; c += 3)
+    {
+      if (m_V[c] != Invalid)
+      {
+        const IndexType t = 3 * start[smallest(c)]++;
+        newCorner[c] = t;
+        newCorner[c + 1] = t + 1;
+        newCorner[c + 2] = t + 2;
       }
     }
     triangles.resize(next);
     std::vector<Link> & opposite = m_ScratchO;
     opposite.resize(next);
-    bool consistent = true;
-    for (std::size_t c = 0; c < numberOfCorners; ++c)
-    {
-      const IndexType nc = newCorner[c];
-      if (nc == Invalid)
+    std::atomic<bool> consistent{ true };
+    this->ParallelFor(numberOfCorners, [&](std::size_t first, std::size_t last) {
+      bool consistentHere = true;
+      for (std::size_t c = first; c < last; ++c)
       {
-        continue;
+        const IndexType nc = newCorner[c];
+        if (nc == Invalid)
+        {
+          continue;
+        }
+        triangles[nc] = newIndex[m_V[c]];
+        const Link o = m_O[c];
+        if (o < 0)
+        {
+          opposite[nc] = o;
+        }
+        else
+        {
+          const IndexType no = newCorner[static_cast<std::size_t>(o)];
+          consistentHere = consistentHere && no != Invalid;
+          opposite[nc] = no != Invalid ? static_cast<Link>(no) : NonManifold;
+        }
       }
-      triangles[nc] = newIndex[m_V[c]];
-      const Link o = m_O[c];
-      if (o < 0)
+      if (!consistentHere)
       {
-        opposite[nc] = o;
+        consistent = false;
       }
-      else
-      {
-        const IndexType no = newCorner[static_cast<std::size_t>(o)];
-        consistent = consistent && no != Invalid;
-        opposite[nc] = no != Invalid ? static_cast<Link>(no) : NonManifold;
-      }
-    }
+    });
     m_V.assign(triangles.begin(), triangles.end());
     m_O.swap(opposite);
     // A table that does not describe the output is built again next time.

@@ -1114,11 +1114,13 @@ struct ParallelBlocks
   MultiThreaderBase * threader;
   unsigned int        workUnits;
 
+  static constexpr SizeValueType Block = 1024;
+
   template <typename TBody>
   void
   operator()(SizeValueType count, TBody && body) const
   {
-    constexpr SizeValueType block = 1024;
+    constexpr SizeValueType block = Block;
     const SizeValueType     blocks = (count + block - 1) / block;
     const auto              run = [&](SizeValueType b) { body(b * block, std::min(count, (b + 1) * block)); };
     if (threader == nullptr || blocks < 2 || workUnits < 2)
@@ -1288,8 +1290,60 @@ public:
                unsigned int                   tupleSize,
                SizeValueType                  numberOfKeys,
                std::vector<TOffset> &         offsets,
-               std::vector<IndexType> &       items)
+               std::vector<IndexType> &       items,
+               MultiThreaderBase *            threader = nullptr,
+               unsigned int                   workUnits = 1)
   {
+    // With a threader, the tuples in a few contiguous ranges, one a thread:
+    // each range counts its keys, then places its tuples after those of the
+    // ranges before it (the same rows as one pass).
+    const SizeValueType numberOfTuples = keys.size() / tupleSize;
+    const SizeValueType ranges =
+      threader == nullptr || keys.size() < 65536
+        ? 1
+        : std::min<SizeValueType>({ workUnits, MultiThreaderBase::GetGlobalDefaultNumberOfThreads(), 8 });
+    if (ranges >= 2)
+    {
+      std::vector<std::vector<TOffset>> slots(ranges);
+      const auto first = [&](SizeValueType r) { return numberOfTuples * r / ranges * tupleSize; };
+      threader->SetNumberOfWorkUnits(static_cast<unsigned int>(ranges));
+      threader->ParallelizeArray(
+        0,
+        ranges,
+        [&](SizeValueType r) {
+          slots[r].assign(numberOfKeys, 0);
+          for (SizeValueType i = first(r); i < first(r + 1); ++i)
+          {
+            ++slots[r][keys[i]];
+          }
+        },
+        nullptr);
+      offsets.resize(numberOfKeys + 1);
+      offsets[0] = 0;
+      for (SizeValueType k = 0; k < numberOfKeys; ++k)
+      {
+        TOffset next = offsets[k];
+        for (SizeValueType r = 0; r < ranges; ++r)
+        {
+          const TOffset count = slots[r][k];
+          slots[r][k] = next;
+          next += count;
+        }
+        offsets[k + 1] = next;
+      }
+      items.resize(keys.size());
+      threader->ParallelizeArray(
+        0,
+        ranges,
+        [&](SizeValueType r) {
+          for (SizeValueType i = first(r); i < first(r + 1); ++i)
+          {
+            items[slots[r][keys[i]]++] = static_cast<IndexType>(i / tupleSize);
+          }
+        },
+        nullptr);
+      return;
+    }
     offsets.assign(numberOfKeys + 1, 0);
     for (const IndexType k : keys)
     {
@@ -1321,50 +1375,111 @@ public:
     m_NumberOfPoints = numberOfPoints;
     m_Triangles.assign(triangles, triangles + 3 * numberOfTriangles);
     // Per point, the triangles that use it.
-    GroupsOfKeys(m_Triangles, 3, numberOfPoints, m_VertexTriangleOffsets, m_VertexTriangles);
+    GroupsOfKeys(m_Triangles, 3, numberOfPoints, m_VertexTriangleOffsets, m_VertexTriangles, threader, workUnits);
     // The pairs sharing exactly one vertex (in one fan, not across an
     // edge): each once, t < u, and per triangle the pairs it is in.
     // In the same pass, whether the surface is closed (IsClosedSurface()):
     // each directed edge (a, b) of a triangle is in no other triangle of a's
     // in that direction and in exactly one in the other.
-    // In blocks of triangles (in parallel with a threader), concatenated in
-    // order: the same list as one pass.
+    // In blocks (in parallel with a threader), concatenated in order: the
+    // same list whatever the threads.
     const SurfaceCollisionDetail::ParallelBlocks parallel{ threader, workUnits };
-    constexpr SizeValueType                      block = 1024;
-    std::vector<std::vector<IndexType>>          blockPairs((numberOfTriangles + block - 1) / block);
-    std::vector<uint8_t>                         blockClosed(blockPairs.size(), 1);
+    constexpr SizeValueType                      block = SurfaceCollisionDetail::ParallelBlocks::Block;
+    std::vector<uint8_t>                         blockDegenerate((numberOfTriangles + block - 1) / block, 0);
     parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
-      auto & pairs = blockPairs[begin / block];
-      bool   closed = true;
       for (SizeValueType t = begin; t < end; ++t)
       {
         const IndexType * vt = m_Triangles.data() + 3 * t;
-        for (unsigned int k = 0; k < 3; ++k)
+        if (vt[0] == vt[1] || vt[1] == vt[2] || vt[2] == vt[0])
         {
-          const IndexType a = vt[k];
-          const IndexType b = vt[(k + 1) % 3];
-          unsigned int    forward = 0;
-          unsigned int    backward = 0;
-          for (SizeValueType f = m_VertexTriangleOffsets[a]; f < m_VertexTriangleOffsets[a + 1]; ++f)
-          {
-            const IndexType   u = m_VertexTriangles[f];
-            const IndexType * vu = m_Triangles.data() + 3 * u;
-            for (unsigned int j = 0; j < 3; ++j)
-            {
-              forward += vu[j] == a && vu[(j + 1) % 3] == b ? 1 : 0;
-              backward += vu[j] == b && vu[(j + 1) % 3] == a ? 1 : 0;
-            }
-            if (u > t && SharedVertices(vt, vu) == 1)
-            {
-              pairs.push_back(static_cast<IndexType>(t));
-              pairs.push_back(u);
-            }
-          }
-          closed = closed && a != b && forward == 1 && backward == 1;
+          blockDegenerate[begin / block] = 1;
+          return;
         }
       }
-      blockClosed[begin / block] = closed ? 1 : 0;
     });
+    const bool degenerate = std::find(blockDegenerate.begin(), blockDegenerate.end(), 1) != blockDegenerate.end();
+    std::vector<std::vector<IndexType>> blockPairs;
+    std::vector<uint8_t>                blockClosed;
+    if (!degenerate)
+    {
+      // Point by point: around point a, each triangle u of its fan is
+      // (a, after[u], before[u]) in its own order. Two triangles of the fan
+      // share a vertex besides a when one's after or before is the other's;
+      // the directed edge (a, b) of a triangle is closed when b is the after
+      // of exactly one triangle of the fan and the before of exactly one.
+      blockPairs.resize((numberOfPoints + block - 1) / block);
+      blockClosed.assign(blockPairs.size(), 1);
+      parallel(numberOfPoints, [&](SizeValueType begin, SizeValueType end) {
+        auto &                 pairs = blockPairs[begin / block];
+        bool                   closed = true;
+        std::vector<IndexType> after;
+        std::vector<IndexType> before;
+        for (SizeValueType a = begin; a < end; ++a)
+        {
+          const SizeValueType first = m_VertexTriangleOffsets[a];
+          const SizeValueType n = m_VertexTriangleOffsets[a + 1] - first;
+          const IndexType *   fan = m_VertexTriangles.data() + first;
+          after.resize(n);
+          before.resize(n);
+          for (SizeValueType i = 0; i < n; ++i)
+          {
+            const IndexType *  vu = m_Triangles.data() + 3 * static_cast<SizeValueType>(fan[i]);
+            const unsigned int j = vu[0] == a ? 0 : (vu[1] == a ? 1 : 2);
+            after[i] = vu[(j + 1) % 3];
+            before[i] = vu[(j + 2) % 3];
+          }
+          for (SizeValueType i = 0; i < n; ++i)
+          {
+            unsigned int forward = 0;
+            unsigned int backward = 0;
+            for (SizeValueType j = 0; j < n; ++j)
+            {
+              forward += after[j] == after[i] ? 1 : 0;
+              backward += before[j] == after[i] ? 1 : 0;
+            }
+            closed = closed && forward == 1 && backward == 1;
+            // A fan lists its triangles in increasing order: t < u.
+            for (SizeValueType j = i + 1; j < n; ++j)
+            {
+              if (after[i] != after[j] && after[i] != before[j] && before[i] != after[j] && before[i] != before[j])
+              {
+                pairs.push_back(fan[i]);
+                pairs.push_back(fan[j]);
+              }
+            }
+          }
+        }
+        blockClosed[begin / block] = closed ? 1 : 0;
+      });
+    }
+    else
+    {
+      // A triangle repeating a point is listed twice in that point's fan:
+      // triangle by triangle instead, as SharedVertices() counts. Such a
+      // surface is not closed.
+      blockPairs.resize((numberOfTriangles + block - 1) / block);
+      blockClosed.assign(blockPairs.size(), 0);
+      parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+        auto & pairs = blockPairs[begin / block];
+        for (SizeValueType t = begin; t < end; ++t)
+        {
+          const IndexType * vt = m_Triangles.data() + 3 * t;
+          for (unsigned int k = 0; k < 3; ++k)
+          {
+            const IndexType a = vt[k];
+            for (SizeValueType f = m_VertexTriangleOffsets[a]; f < m_VertexTriangleOffsets[a + 1]; ++f)
+            {
+              const IndexType u = m_VertexTriangles[f];
+              if (u > t && SharedVertices(vt, m_Triangles.data() + 3 * static_cast<SizeValueType>(u)) == 1)
+              {
+                pairs.push_back(static_cast<IndexType>(t));
+                pairs.push_back(u);
+              }
+            }
+          }
+        }
+      });
+    }
     m_SharedPairs.clear();
     bool closed = numberOfTriangles >= 4;
     for (SizeValueType b = 0; b < blockPairs.size(); ++b)
@@ -1373,7 +1488,7 @@ public:
       closed = closed && blockClosed[b] != 0;
     }
     const SizeValueType numberOfSharedPairs = m_SharedPairs.size() / 2;
-    GroupsOfKeys(m_SharedPairs, 2, numberOfTriangles, m_SharedOffsets, m_SharedOfTriangle);
+    GroupsOfKeys(m_SharedPairs, 2, numberOfTriangles, m_SharedOffsets, m_SharedOfTriangle, threader, workUnits);
     // The other triangle of each entry, read at every step without a visit
     // to the pair.
     m_SharedPartner.resize(m_SharedOfTriangle.size());
