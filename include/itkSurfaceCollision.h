@@ -1364,7 +1364,9 @@ public:
   /** Sets the surface's connectivity: \a numberOfTriangles triangles of 3
    * point indices (< numberOfPoints) each. Drops the spatial index; the next
    * Constrain() builds it. Call again whenever the mesh changes (remeshing,
-   * renumbering). */
+   * renumbering). The tables of the pairs of triangles sharing one vertex
+   * are made when the index first needs them: a surface accepted by the
+   * star-shaped certificate at every step never needs them. */
   void
   SetSurface(SizeValueType       numberOfPoints,
              const IndexType *   triangles,
@@ -1376,13 +1378,13 @@ public:
     m_Triangles.assign(triangles, triangles + 3 * numberOfTriangles);
     // Per point, the triangles that use it.
     GroupsOfKeys(m_Triangles, 3, numberOfPoints, m_VertexTriangleOffsets, m_VertexTriangles, threader, workUnits);
-    // The pairs sharing exactly one vertex (in one fan, not across an
-    // edge): each once, t < u, and per triangle the pairs it is in.
-    // In the same pass, whether the surface is closed (IsClosedSurface()):
-    // each directed edge (a, b) of a triangle is in no other triangle of a's
-    // in that direction and in exactly one in the other.
-    // In blocks (in parallel with a threader), concatenated in order: the
-    // same list whatever the threads.
+    // Whether a triangle repeats a point, and whether the surface is closed
+    // (IsClosedSurface()): each directed edge (a, b) of a triangle is in no
+    // other triangle of a's in that direction and in exactly one in the
+    // other. Point by point: around point a, each triangle u of its fan is
+    // (a, after, before) in its own order; the directed edge (a, b) of a
+    // triangle is closed when b is the after of exactly one triangle of the
+    // fan and the before of exactly one.
     const SurfaceCollisionDetail::ParallelBlocks parallel{ threader, workUnits };
     constexpr SizeValueType                      block = SurfaceCollisionDetail::ParallelBlocks::Block;
     std::vector<uint8_t>                         blockDegenerate((numberOfTriangles + block - 1) / block, 0);
@@ -1397,37 +1399,18 @@ public:
         }
       }
     });
-    const bool degenerate = std::find(blockDegenerate.begin(), blockDegenerate.end(), 1) != blockDegenerate.end();
-    std::vector<std::vector<IndexType>> blockPairs;
-    std::vector<uint8_t>                blockClosed;
-    if (!degenerate)
+    m_RepeatedPoint = std::find(blockDegenerate.begin(), blockDegenerate.end(), 1) != blockDegenerate.end();
+    bool closed = numberOfTriangles >= 4 && !m_RepeatedPoint;
+    if (closed)
     {
-      // Point by point: around point a, each triangle u of its fan is
-      // (a, after[u], before[u]) in its own order. Two triangles of the fan
-      // share a vertex besides a when one's after or before is the other's;
-      // the directed edge (a, b) of a triangle is closed when b is the after
-      // of exactly one triangle of the fan and the before of exactly one.
-      blockPairs.resize((numberOfPoints + block - 1) / block);
-      blockClosed.assign(blockPairs.size(), 1);
+      std::vector<uint8_t> blockClosed((numberOfPoints + block - 1) / block, 1);
       parallel(numberOfPoints, [&](SizeValueType begin, SizeValueType end) {
-        auto &                 pairs = blockPairs[begin / block];
-        bool                   closed = true;
         std::vector<IndexType> after;
         std::vector<IndexType> before;
         for (SizeValueType a = begin; a < end; ++a)
         {
-          const SizeValueType first = m_VertexTriangleOffsets[a];
-          const SizeValueType n = m_VertexTriangleOffsets[a + 1] - first;
-          const IndexType *   fan = m_VertexTriangles.data() + first;
-          after.resize(n);
-          before.resize(n);
-          for (SizeValueType i = 0; i < n; ++i)
-          {
-            const IndexType *  vu = m_Triangles.data() + 3 * static_cast<SizeValueType>(fan[i]);
-            const unsigned int j = vu[0] == a ? 0 : (vu[1] == a ? 1 : 2);
-            after[i] = vu[(j + 1) % 3];
-            before[i] = vu[(j + 2) % 3];
-          }
+          this->FanNeighbours(a, after, before);
+          const SizeValueType n = after.size();
           for (SizeValueType i = 0; i < n; ++i)
           {
             unsigned int forward = 0;
@@ -1437,73 +1420,24 @@ public:
               forward += after[j] == after[i] ? 1 : 0;
               backward += before[j] == after[i] ? 1 : 0;
             }
-            closed = closed && forward == 1 && backward == 1;
-            // A fan lists its triangles in increasing order: t < u.
-            for (SizeValueType j = i + 1; j < n; ++j)
+            if (forward != 1 || backward != 1)
             {
-              if (after[i] != after[j] && after[i] != before[j] && before[i] != after[j] && before[i] != before[j])
-              {
-                pairs.push_back(fan[i]);
-                pairs.push_back(fan[j]);
-              }
-            }
-          }
-        }
-        blockClosed[begin / block] = closed ? 1 : 0;
-      });
-    }
-    else
-    {
-      // A triangle repeating a point is listed twice in that point's fan:
-      // triangle by triangle instead, as SharedVertices() counts. Such a
-      // surface is not closed.
-      blockPairs.resize((numberOfTriangles + block - 1) / block);
-      blockClosed.assign(blockPairs.size(), 0);
-      parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
-        auto & pairs = blockPairs[begin / block];
-        for (SizeValueType t = begin; t < end; ++t)
-        {
-          const IndexType * vt = m_Triangles.data() + 3 * t;
-          for (unsigned int k = 0; k < 3; ++k)
-          {
-            const IndexType a = vt[k];
-            for (SizeValueType f = m_VertexTriangleOffsets[a]; f < m_VertexTriangleOffsets[a + 1]; ++f)
-            {
-              const IndexType u = m_VertexTriangles[f];
-              if (u > t && SharedVertices(vt, m_Triangles.data() + 3 * static_cast<SizeValueType>(u)) == 1)
-              {
-                pairs.push_back(static_cast<IndexType>(t));
-                pairs.push_back(u);
-              }
+              blockClosed[begin / block] = 0;
+              return;
             }
           }
         }
       });
+      closed = std::find(blockClosed.begin(), blockClosed.end(), 0) == blockClosed.end();
     }
+    m_SharedPairsReady = false;
     m_SharedPairs.clear();
-    bool closed = numberOfTriangles >= 4;
-    for (SizeValueType b = 0; b < blockPairs.size(); ++b)
-    {
-      m_SharedPairs.insert(m_SharedPairs.end(), blockPairs[b].begin(), blockPairs[b].end());
-      closed = closed && blockClosed[b] != 0;
-    }
-    const SizeValueType numberOfSharedPairs = m_SharedPairs.size() / 2;
-    GroupsOfKeys(m_SharedPairs, 2, numberOfTriangles, m_SharedOffsets, m_SharedOfTriangle, threader, workUnits);
-    // The other triangle of each entry, read at every step without a visit
-    // to the pair.
-    m_SharedPartner.resize(m_SharedOfTriangle.size());
-    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
-      for (SizeValueType t = begin; t < end; ++t)
-      {
-        for (IndexType k = m_SharedOffsets[t]; k < m_SharedOffsets[t + 1]; ++k)
-        {
-          m_SharedPartner[k] = this->OtherOfShared(m_SharedOfTriangle[k], t);
-        }
-      }
-    });
-    m_SharedGaps.assign(numberOfSharedPairs, 0.0f);
-    m_SharedExact.assign(numberOfSharedPairs, 0);
-    m_SharedComputed.assign(numberOfSharedPairs, 0.0f);
+    m_SharedOffsets.clear();
+    m_SharedOfTriangle.clear();
+    m_SharedPartner.clear();
+    m_SharedGaps.clear();
+    m_SharedExact.clear();
+    m_SharedComputed.clear();
     m_Closed = closed;
     m_CertificateWait = 0;
     m_CertificateBackoff = 0;
@@ -1705,6 +1639,7 @@ public:
     {
       return 0;
     }
+    this->EnsureSharedPairs(parallel);
     if (!this->Build(x, minimumDistance, parallel, false))
     {
       return 0;
@@ -1796,6 +1731,7 @@ public:
       m_NumberOfDeferredTriangles = 0;
       return result;
     }
+    this->EnsureSharedPairs(parallel);
 
     // The bounds at y; when one fails the index is rebuilt at y (where
     // every displacement is zero and every bound holds).
@@ -4050,6 +3986,122 @@ private:
     c[3] = std::sqrt(r2) * (1.0 + 1e-12);
   }
 
+  /** Around point a, the other two points of each triangle of its fan
+   * (in the order of the fan's list), as (a, after, before) in the
+   * triangle's own order. */
+  void
+  FanNeighbours(SizeValueType a, std::vector<IndexType> & after, std::vector<IndexType> & before) const
+  {
+    const SizeValueType first = m_VertexTriangleOffsets[a];
+    const SizeValueType n = m_VertexTriangleOffsets[a + 1] - first;
+    after.resize(n);
+    before.resize(n);
+    for (SizeValueType i = 0; i < n; ++i)
+    {
+      const IndexType *  vu = m_Triangles.data() + 3 * static_cast<SizeValueType>(m_VertexTriangles[first + i]);
+      const unsigned int j = vu[0] == a ? 0 : (vu[1] == a ? 1 : 2);
+      after[i] = vu[(j + 1) % 3];
+      before[i] = vu[(j + 2) % 3];
+    }
+  }
+
+  /** The tables of the pairs of triangles sharing exactly one vertex (in
+   * one fan, not across an edge), made once per SetSurface() when first
+   * needed: each pair once, t < u, and per triangle the pairs it is in. In
+   * blocks (in parallel with a threader), concatenated in order: the same
+   * list whatever the threads. */
+  void
+  EnsureSharedPairs(const SurfaceCollisionDetail::ParallelBlocks & parallel)
+  {
+    if (m_SharedPairsReady)
+    {
+      return;
+    }
+    const SizeValueType                 numberOfPoints = m_NumberOfPoints;
+    const SizeValueType                 numberOfTriangles = this->GetNumberOfTriangles();
+    constexpr SizeValueType             block = SurfaceCollisionDetail::ParallelBlocks::Block;
+    std::vector<std::vector<IndexType>> blockPairs;
+    if (!m_RepeatedPoint)
+    {
+      // Point by point: two triangles of a's fan share a vertex besides a
+      // when one's after or before is the other's.
+      blockPairs.resize((numberOfPoints + block - 1) / block);
+      parallel(numberOfPoints, [&](SizeValueType begin, SizeValueType end) {
+        auto &                 pairs = blockPairs[begin / block];
+        std::vector<IndexType> after;
+        std::vector<IndexType> before;
+        for (SizeValueType a = begin; a < end; ++a)
+        {
+          this->FanNeighbours(a, after, before);
+          const IndexType *   fan = m_VertexTriangles.data() + m_VertexTriangleOffsets[a];
+          const SizeValueType n = after.size();
+          // A fan lists its triangles in increasing order: t < u.
+          for (SizeValueType i = 0; i < n; ++i)
+          {
+            for (SizeValueType j = i + 1; j < n; ++j)
+            {
+              if (after[i] != after[j] && after[i] != before[j] && before[i] != after[j] && before[i] != before[j])
+              {
+                pairs.push_back(fan[i]);
+                pairs.push_back(fan[j]);
+              }
+            }
+          }
+        }
+      });
+    }
+    else
+    {
+      // A triangle repeating a point is listed twice in that point's fan:
+      // triangle by triangle instead, as SharedVertices() counts.
+      blockPairs.resize((numberOfTriangles + block - 1) / block);
+      parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+        auto & pairs = blockPairs[begin / block];
+        for (SizeValueType t = begin; t < end; ++t)
+        {
+          const IndexType * vt = m_Triangles.data() + 3 * t;
+          for (unsigned int k = 0; k < 3; ++k)
+          {
+            const IndexType a = vt[k];
+            for (SizeValueType f = m_VertexTriangleOffsets[a]; f < m_VertexTriangleOffsets[a + 1]; ++f)
+            {
+              const IndexType u = m_VertexTriangles[f];
+              if (u > t && SharedVertices(vt, m_Triangles.data() + 3 * static_cast<SizeValueType>(u)) == 1)
+              {
+                pairs.push_back(static_cast<IndexType>(t));
+                pairs.push_back(u);
+              }
+            }
+          }
+        }
+      });
+    }
+    m_SharedPairs.clear();
+    for (const auto & pairs : blockPairs)
+    {
+      m_SharedPairs.insert(m_SharedPairs.end(), pairs.begin(), pairs.end());
+    }
+    const SizeValueType numberOfSharedPairs = m_SharedPairs.size() / 2;
+    GroupsOfKeys(
+      m_SharedPairs, 2, numberOfTriangles, m_SharedOffsets, m_SharedOfTriangle, parallel.threader, parallel.workUnits);
+    // The other triangle of each entry, read at every step without a visit
+    // to the pair.
+    m_SharedPartner.resize(m_SharedOfTriangle.size());
+    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+      for (SizeValueType t = begin; t < end; ++t)
+      {
+        for (IndexType k = m_SharedOffsets[t]; k < m_SharedOffsets[t + 1]; ++k)
+        {
+          m_SharedPartner[k] = this->OtherOfShared(m_SharedOfTriangle[k], t);
+        }
+      }
+    });
+    m_SharedGaps.assign(numberOfSharedPairs, 0.0f);
+    m_SharedExact.assign(numberOfSharedPairs, 0);
+    m_SharedComputed.assign(numberOfSharedPairs, 0.0f);
+    m_SharedPairsReady = true;
+  }
+
   SizeValueType              m_NumberOfPoints{ 0 };
   bool                       m_HasSurface{ false };
   std::vector<IndexType>     m_Triangles;
@@ -4063,7 +4115,9 @@ private:
   std::vector<uint8_t>       m_SharedExact;      // per shared pair: the bound is the exact gap
   std::vector<float>         m_SharedComputed;   // per shared pair: its bound when last computed (not carried)
 
-  bool          m_Closed{ false }; // IsClosedSurface()
+  bool          m_Closed{ false };           // IsClosedSurface()
+  bool          m_RepeatedPoint{ false };    // a triangle of SetSurface() repeats a point
+  bool          m_SharedPairsReady{ false }; // EnsureSharedPairs() ran since SetSurface()
   bool          m_UseStarCertificate{ true };
   SizeValueType m_NumberOfCertifiedSteps{ 0 };
   unsigned int  m_CertificateWait{ 0 };    // calls to skip before the next try
