@@ -355,6 +355,18 @@ private:
   template <typename TCandidate, typename TBody>
   void
   Sweep(SweepInputs inputs, TCandidate && candidate, TBody && body);
+  /** Runs body(c) for the corners queued in m_Queue, in increasing order
+   * (the second half of Sweep()). */
+  template <typename TBody>
+  void
+  RunQueue(SweepInputs inputs, TBody && body);
+  /** Whether the edge of corner c is short, listed from c: an interior
+   * edge seen from the lower of its two corners. */
+  bool
+  ShortEdge(IndexType c) const
+  {
+    return m_V[c] != Invalid && m_O[c] >= static_cast<int64_t>(c) && this->Length2(m_V[c], m_V[Next(c)]) < m_Min2;
+  }
   /** Queues corner \a k and its twin for the running sweep, when ahead of it. */
   void
   Requeue(int64_t k)
@@ -394,7 +406,14 @@ private:
   bool                   m_TableValid{ false };
   std::vector<uint8_t>   m_Locked;       // SetLockedVertices(), for the next Remesh()
   std::vector<IndexType> m_SplitTouched; // triangles the splits of a pass changed or made
-  std::vector<IndexType> m_NewIndex;     // scratch of Compact()
+  // The short edges found by the scan of SplitPass(true), a bit per corner
+  // as CollapsePass() lists them, and the triangles whose corners the
+  // splits since then changed (their edges, or the corner an edge is listed
+  // from): the next CollapsePass() starts from these instead of a scan.
+  std::vector<uint64_t>  m_ShortEdges;
+  std::vector<IndexType> m_ShortEdgesStale;
+  bool                   m_ShortEdgesValid{ false };
+  std::vector<IndexType> m_NewIndex; // scratch of Compact()
   std::vector<IndexType> m_NewCorner;
   std::size_t            m_InputPoints{ 0 };
   Statistics             m_Statistics;
@@ -523,6 +542,14 @@ DeformableMeshRemesher::Sweep(SweepInputs inputs, TCandidate && candidate, TBody
       }
     },
     1024);
+  this->RunQueue(inputs, std::forward<TBody>(body));
+}
+
+template <typename TBody>
+void
+DeformableMeshRemesher::RunQueue(SweepInputs inputs, TBody && body)
+{
+  const std::size_t words = m_Queue.size();
   m_SweepInputs = inputs;
   for (std::size_t w = 0; w < words; ++w)
   {
@@ -833,6 +860,19 @@ DeformableMeshRemesher::Split(IndexType c)
     m_SplitTouched.push_back(static_cast<IndexType>(o) / 3);
     m_SplitTouched.push_back(t2 / 3 + 1);
   }
+  if (m_ShortEdgesValid)
+  {
+    // Besides the triangles changed or made, those whose corner's twin
+    // moved to a new corner: the corner their edge is listed from may change.
+    m_ShortEdgesStale.insert(m_ShortEdgesStale.end(), m_SplitTouched.end() - (o >= 0 ? 4 : 2), m_SplitTouched.end());
+    for (const Link k : { oldNext, o >= 0 ? m_O[t2 + 4] : Link{ Boundary } }) // t2 + 4: a -> D
+    {
+      if (k >= 0)
+      {
+        m_ShortEdgesStale.push_back(static_cast<IndexType>(k) / 3);
+      }
+    }
+  }
   ++m_Statistics.splits;
 }
 
@@ -869,14 +909,17 @@ DeformableMeshRemesher::SplitPass(bool all)
   if (all)
   {
     // In parallel: the candidates are sorted below, so their order here
-    // does not matter.
+    // does not matter. In the same scan, the short edges for the next
+    // CollapsePass() (blocks of whole 64-bit words).
     constexpr std::size_t                                  blockSize = 65536;
     const std::size_t                                      numberOfCorners = m_V.size();
     std::vector<std::vector<std::pair<double, IndexType>>> parts((numberOfCorners + blockSize - 1) / blockSize);
+    m_ShortEdges.assign((numberOfCorners + 63) / 64, 0);
     this->ParallelFor(
       numberOfCorners,
       [&](std::size_t first, std::size_t last) {
         std::vector<std::pair<double, IndexType>> & part = parts[first / blockSize];
+        uint64_t                                    bits = 0;
         for (std::size_t c = first; c < last; ++c)
         {
           const Link o = m_O[c];
@@ -884,9 +927,17 @@ DeformableMeshRemesher::SplitPass(bool all)
           {
             consider(static_cast<IndexType>(c), part);
           }
+          bits |= static_cast<uint64_t>(this->ShortEdge(static_cast<IndexType>(c))) << (c & 63);
+          if ((c & 63) == 63 || c + 1 == last)
+          {
+            m_ShortEdges[c >> 6] = bits;
+            bits = 0;
+          }
         }
       },
       blockSize);
+    m_ShortEdgesStale.clear();
+    m_ShortEdgesValid = true;
     for (const auto & part : parts)
     {
       candidates.insert(candidates.end(), part.begin(), part.end());
@@ -1112,18 +1163,36 @@ DeformableMeshRemesher::CollapsePass()
 {
   // The short edges: those of the mesh before the pass, and those that the
   // collapses and flips of the pass change (queued again).
-  const auto shortEdge = [this](IndexType c) {
-    // Not removed, boundary, frozen, or seen from its twin.
-    return m_V[c] != Invalid && m_O[c] >= static_cast<int64_t>(c) && this->Length2(m_V[c], m_V[Next(c)]) < m_Min2;
-  };
-  this->Sweep(SweepInputs::Lengths, shortEdge, [&](IndexType c) {
+  const auto shortEdge = [this](IndexType c) { return this->ShortEdge(c); };
+  const auto body = [&](IndexType c) {
     // A short edge that cannot be collapsed is flipped to the longer
     // diagonal when that one is within the band.
     if (shortEdge(c) && !this->TryCollapse(c))
     {
       this->TryFlip(c, true);
     }
-  });
+  };
+  if (!m_ShortEdgesValid)
+  {
+    this->Sweep(SweepInputs::Lengths, shortEdge, body);
+    return;
+  }
+  // The short edges of the last SplitPass(true)'s scan, those of the
+  // triangles its splits changed or made looked at again: the queue a scan
+  // would give.
+  m_Queue.swap(m_ShortEdges);
+  m_Queue.resize((m_V.size() + 63) / 64, 0);
+  for (const IndexType t : m_ShortEdgesStale)
+  {
+    for (IndexType c = 3 * t; c < 3 * t + 3; ++c)
+    {
+      const uint64_t bit = uint64_t{ 1 } << (c & 63);
+      m_Queue[c >> 6] = shortEdge(c) ? (m_Queue[c >> 6] | bit) : (m_Queue[c >> 6] & ~bit);
+    }
+  }
+  m_ShortEdgesStale.clear();
+  m_ShortEdgesValid = false;
+  this->RunQueue(SweepInputs::Lengths, body);
 }
 
 inline bool
@@ -1695,6 +1764,7 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
     }
   }
   m_Statistics = Statistics{};
+  m_ShortEdgesValid = false;
   m_InputPoints = numberOfPoints;
   m_Min2 = GetMinimumEdgeLength() * GetMinimumEdgeLength();
   m_Max2 = GetMaximumEdgeLength() * GetMaximumEdgeLength();
