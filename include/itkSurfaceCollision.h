@@ -1290,60 +1290,8 @@ public:
                unsigned int                   tupleSize,
                SizeValueType                  numberOfKeys,
                std::vector<TOffset> &         offsets,
-               std::vector<IndexType> &       items,
-               MultiThreaderBase *            threader = nullptr,
-               unsigned int                   workUnits = 1)
+               std::vector<IndexType> &       items)
   {
-    // With a threader, the tuples in a few contiguous ranges, one a thread:
-    // each range counts its keys, then places its tuples after those of the
-    // ranges before it (the same rows as one pass).
-    const SizeValueType numberOfTuples = keys.size() / tupleSize;
-    const SizeValueType ranges =
-      threader == nullptr || keys.size() < 65536
-        ? 1
-        : std::min<SizeValueType>({ workUnits, MultiThreaderBase::GetGlobalDefaultNumberOfThreads(), 8 });
-    if (ranges >= 2)
-    {
-      std::vector<std::vector<TOffset>> slots(ranges);
-      const auto first = [&](SizeValueType r) { return numberOfTuples * r / ranges * tupleSize; };
-      threader->SetNumberOfWorkUnits(static_cast<unsigned int>(ranges));
-      threader->ParallelizeArray(
-        0,
-        ranges,
-        [&](SizeValueType r) {
-          slots[r].assign(numberOfKeys, 0);
-          for (SizeValueType i = first(r); i < first(r + 1); ++i)
-          {
-            ++slots[r][keys[i]];
-          }
-        },
-        nullptr);
-      offsets.resize(numberOfKeys + 1);
-      offsets[0] = 0;
-      for (SizeValueType k = 0; k < numberOfKeys; ++k)
-      {
-        TOffset next = offsets[k];
-        for (SizeValueType r = 0; r < ranges; ++r)
-        {
-          const TOffset count = slots[r][k];
-          slots[r][k] = next;
-          next += count;
-        }
-        offsets[k + 1] = next;
-      }
-      items.resize(keys.size());
-      threader->ParallelizeArray(
-        0,
-        ranges,
-        [&](SizeValueType r) {
-          for (SizeValueType i = first(r); i < first(r + 1); ++i)
-          {
-            items[slots[r][keys[i]]++] = static_cast<IndexType>(i / tupleSize);
-          }
-        },
-        nullptr);
-      return;
-    }
     offsets.assign(numberOfKeys + 1, 0);
     for (const IndexType k : keys)
     {
@@ -1377,7 +1325,7 @@ public:
     m_NumberOfPoints = numberOfPoints;
     m_Triangles.assign(triangles, triangles + 3 * numberOfTriangles);
     // Per point, the triangles that use it.
-    GroupsOfKeys(m_Triangles, 3, numberOfPoints, m_VertexTriangleOffsets, m_VertexTriangles, threader, workUnits);
+    GroupsOfKeys(m_Triangles, 3, numberOfPoints, m_VertexTriangleOffsets, m_VertexTriangles);
     // Whether a triangle repeats a point, and whether the surface is closed
     // (IsClosedSurface()): each directed edge (a, b) of a triangle is in no
     // other triangle of a's in that direction and in exactly one in the
@@ -4082,8 +4030,7 @@ private:
       m_SharedPairs.insert(m_SharedPairs.end(), pairs.begin(), pairs.end());
     }
     const SizeValueType numberOfSharedPairs = m_SharedPairs.size() / 2;
-    GroupsOfKeys(
-      m_SharedPairs, 2, numberOfTriangles, m_SharedOffsets, m_SharedOfTriangle, parallel.threader, parallel.workUnits);
+    GroupsOfKeys(m_SharedPairs, 2, numberOfTriangles, m_SharedOffsets, m_SharedOfTriangle);
     // The other triangle of each entry, read at every step without a visit
     // to the pair.
     m_SharedPartner.resize(m_SharedOfTriangle.size());
