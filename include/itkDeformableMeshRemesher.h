@@ -1370,6 +1370,7 @@ DeformableMeshRemesher::Relax()
     std::copy(m_X.begin() + 3 * first, m_X.begin() + 3 * last, moved.begin() + 3 * first);
     std::vector<IndexType> ring; // per block
     std::vector<IndexType> corners;
+    std::vector<double>    around;  // the neighbours' positions, the first again at the end
     std::vector<double>    normals; // of the vertex's triangles, as they are
     std::size_t            count = 0;
     for (std::size_t i = first; i < last; ++i)
@@ -1378,28 +1379,42 @@ DeformableMeshRemesher::Relax()
       {
         continue;
       }
+      // A free vertex's fan is closed: the triangle of corner j is
+      // (i, ring[j], ring[j + 1]). The neighbours' positions are read once.
+      const std::size_t n = corners.size();
+      bool              closed = ring.size() == n && n >= 3;
+      for (std::size_t j = 0; closed && j < n; ++j)
+      {
+        closed = m_V[Prev(corners[j])] == ring[j + 1 < n ? j + 1 : 0];
+      }
+      if (!closed)
+      {
+        continue;
+      }
+      around.resize(3 * (n + 1));
+      for (std::size_t j = 0; j <= n; ++j)
+      {
+        const double * w = m_X.data() + 3 * static_cast<std::size_t>(ring[j < n ? j : 0]);
+        std::copy(w, w + 3, around.data() + 3 * j);
+      }
       const double * p = m_X.data() + 3 * i;
       double         centroid[3] = { 0.0, 0.0, 0.0 };
       double         normal[3] = { 0.0, 0.0, 0.0 };
-      for (const IndexType w : ring)
+      for (std::size_t j = 0; j < n; ++j)
       {
         for (unsigned int d = 0; d < 3; ++d)
         {
-          centroid[d] += m_X[3 * static_cast<std::size_t>(w) + d];
+          centroid[d] += around[3 * j + d];
         }
       }
-      normals.resize(3 * corners.size());
-      for (std::size_t j = 0; j < corners.size(); ++j)
+      normals.resize(3 * n);
+      for (std::size_t j = 0; j < n; ++j)
       {
-        const IndexType k = corners[j];
-        double *        n = normals.data() + 3 * j;
-        this->TriangleNormal(p,
-                             m_X.data() + 3 * static_cast<std::size_t>(m_V[Next(k)]),
-                             m_X.data() + 3 * static_cast<std::size_t>(m_V[Prev(k)]),
-                             n);
+        double * nj = normals.data() + 3 * j;
+        this->TriangleNormal(p, around.data() + 3 * j, around.data() + 3 * j + 3, nj);
         for (unsigned int d = 0; d < 3; ++d)
         {
-          normal[d] += n[d];
+          normal[d] += nj[d];
         }
       }
       const double length = std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
@@ -1412,7 +1427,7 @@ DeformableMeshRemesher::Relax()
       for (unsigned int d = 0; d < 3; ++d)
       {
         normal[d] /= length;
-        step[d] = centroid[d] / static_cast<double>(ring.size()) - p[d];
+        step[d] = centroid[d] / static_cast<double>(n) - p[d];
         along += step[d] * normal[d];
       }
       double q[3];
@@ -1422,14 +1437,11 @@ DeformableMeshRemesher::Relax()
       }
       // Refuse a move that turns one of the vertex's triangles around.
       bool keeps = true;
-      for (std::size_t j = 0; j < corners.size(); ++j)
+      for (std::size_t j = 0; j < n; ++j)
       {
-        const IndexType k = corners[j];
-        const double *  q1 = m_X.data() + 3 * static_cast<std::size_t>(m_V[Next(k)]);
-        const double *  q2 = m_X.data() + 3 * static_cast<std::size_t>(m_V[Prev(k)]);
-        const double *  before = normals.data() + 3 * j;
-        double          after[3];
-        this->TriangleNormal(q, q1, q2, after);
+        const double * before = normals.data() + 3 * j;
+        double         after[3];
+        this->TriangleNormal(q, around.data() + 3 * j, around.data() + 3 * j + 3, after);
         if (!(before[0] * after[0] + before[1] * after[1] + before[2] * after[2] > 0.0))
         {
           keeps = false;
