@@ -377,6 +377,10 @@ private:
       {
         m_Queue[static_cast<std::size_t>(corner) >> 6] |= uint64_t{ 1 } << (corner & 63);
       }
+      else if (m_TrackStillShort && corner >= 0)
+      {
+        m_StillShort.push_back(static_cast<IndexType>(corner));
+      }
     }
   }
   /** Queues the three corners (and their twins) of each triangle of the
@@ -413,6 +417,12 @@ private:
   std::vector<uint64_t>  m_ShortEdges;
   std::vector<IndexType> m_ShortEdgesStale;
   bool                   m_ShortEdgesValid{ false };
+  // The corners whose edge may still be short after a CollapsePass(): those
+  // it visited and left short, and those it changed behind its position.
+  // The LengthenPass() right after it starts from these instead of a scan.
+  std::vector<IndexType> m_StillShort;
+  bool                   m_TrackStillShort{ false };
+  bool                   m_StillShortValid{ false };
   std::vector<IndexType> m_NewIndex; // scratch of Compact()
   std::vector<IndexType> m_NewCorner;
   std::size_t            m_InputPoints{ 0 };
@@ -879,6 +889,7 @@ DeformableMeshRemesher::Split(IndexType c)
 inline bool
 DeformableMeshRemesher::SplitPass(bool all)
 {
+  m_StillShortValid = false;
   // The long edges of the mesh as it is, longest first: splitting a long
   // edge before the shorter ones around it avoids fans of thin triangles.
   // Each edge is listed from its corner of lower index (or its only one).
@@ -1171,10 +1182,19 @@ DeformableMeshRemesher::CollapsePass()
     {
       this->TryFlip(c, true);
     }
+    if (shortEdge(c))
+    {
+      m_StillShort.push_back(c);
+    }
   };
+  m_StillShort.clear();
+  m_TrackStillShort = true;
+  m_StillShortValid = false;
   if (!m_ShortEdgesValid)
   {
     this->Sweep(SweepInputs::Lengths, shortEdge, body);
+    m_TrackStillShort = false;
+    m_StillShortValid = true;
     return;
   }
   // The short edges of the last SplitPass(true)'s scan, those of the
@@ -1193,6 +1213,8 @@ DeformableMeshRemesher::CollapsePass()
   m_ShortEdgesStale.clear();
   m_ShortEdgesValid = false;
   this->RunQueue(SweepInputs::Lengths, body);
+  m_TrackStillShort = false;
+  m_StillShortValid = true;
 }
 
 inline bool
@@ -1346,6 +1368,7 @@ DeformableMeshRemesher::TryFlip(IndexType c, bool lengthen)
 inline void
 DeformableMeshRemesher::FlipPass()
 {
+  m_StillShortValid = false;
   this->Sweep(
     SweepInputs::Valences,
     [this](IndexType c) { return m_V[c] != Invalid && this->FlipImprovesValences(c); },
@@ -1360,6 +1383,7 @@ DeformableMeshRemesher::FlipPass()
 inline void
 DeformableMeshRemesher::Relax()
 {
+  m_StillShortValid = false;
   const std::size_t     numberOfPoints = m_State.size();
   std::vector<double> & moved = m_Moved;
   moved.resize(m_X.size());
@@ -1517,7 +1541,7 @@ DeformableMeshRemesher::LengthenPass()
     const double length2 = this->Length2(m_V[c], m_V[Next(c)]);
     return length2 < m_Min2 && length2 > 0.0;
   };
-  this->Sweep(SweepInputs::None, shortEdge, [&](IndexType c) {
+  const auto body = [&](IndexType c) {
     if (!shortEdge(c))
     {
       return;
@@ -1567,7 +1591,24 @@ DeformableMeshRemesher::LengthenPass()
         }
       }
     }
-  });
+  };
+  if (!m_StillShortValid)
+  {
+    this->Sweep(SweepInputs::None, shortEdge, body);
+    return;
+  }
+  // The CollapsePass() just before left these corners possibly short: the
+  // queue a scan would give.
+  m_StillShortValid = false;
+  m_Queue.assign((m_V.size() + 63) / 64, 0);
+  for (const IndexType c : m_StillShort)
+  {
+    if (shortEdge(c))
+    {
+      m_Queue[c >> 6] |= uint64_t{ 1 } << (c & 63);
+    }
+  }
+  this->RunQueue(SweepInputs::None, body);
 }
 
 inline void
@@ -1777,6 +1818,7 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
   }
   m_Statistics = Statistics{};
   m_ShortEdgesValid = false;
+  m_StillShortValid = false;
   m_InputPoints = numberOfPoints;
   m_Min2 = GetMinimumEdgeLength() * GetMinimumEdgeLength();
   m_Max2 = GetMaximumEdgeLength() * GetMaximumEdgeLength();
