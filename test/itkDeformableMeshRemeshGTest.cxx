@@ -376,6 +376,19 @@ TEST(DeformableMeshRemesher, KeptTableGivesTheSameMeshAsAFreshOne)
     ASSERT_EQ(edgesKept, edgesFresh) << "round " << round;
     EXPECT_EQ(keeping.GetTopologyChanged(), statistics.splits + statistics.collapses + statistics.flips > 0);
     unchanged = unchanged || !keeping.GetTopologyChanged();
+    if (statistics.splits + statistics.collapses > 0)
+    {
+      // Points added or removed: the triangles come in the order of their
+      // smallest point, so that a fan's corners are near each other.
+      IndexType previous = 0;
+      for (std::size_t t = 0; t < kept.triangles.size() / 3; ++t)
+      {
+        const IndexType smallest =
+          std::min({ kept.triangles[3 * t], kept.triangles[3 * t + 1], kept.triangles[3 * t + 2] });
+        ASSERT_GE(smallest, previous) << "round " << round << ", triangle " << t;
+        previous = smallest;
+      }
+    }
     // A stretch along z, as a deformation between remeshings.
     for (std::size_t i = 0; i < kept.Points(); ++i)
     {
