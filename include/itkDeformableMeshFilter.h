@@ -579,6 +579,21 @@ public:
   itkGetConstMacro(TotalNumberOfCollisionsPrevented, SizeValueType);
   itkGetConstMacro(NumberOfConstrainedVertices, SizeValueType);
 
+  /** How the collision test went since the filter was made: the steps
+   * (and remeshings) whose positions the star-shaped certificate accepted
+   * without the index, and the times the index over the triangles was built
+   * (see SurfaceCollision). */
+  SizeValueType
+  GetNumberOfCertifiedSteps() const
+  {
+    return m_Collision.GetTotalNumberOfCertifiedSteps();
+  }
+  SizeValueType
+  GetNumberOfCollisionIndexRebuilds() const
+  {
+    return m_Collision.GetTotalNumberOfRebuilds();
+  }
+
   /** True when the last update stopped because of convergence. */
   itkGetConstMacro(Converged, bool);
 

@@ -992,13 +992,18 @@ DeformableMeshFilter<TMesh, TForceImage>::ResetCollision(const std::vector<uint3
                          numberOfTriangles,
                          this->GetMultiThreader(),
                          this->GetNumberOfWorkUnits());
-  if (!check)
+  if (!check ||
+      m_Collision.IsStarShaped(this->GetCoordinates().data(), this->GetMultiThreader(), this->GetNumberOfWorkUnits()))
   {
-    return;
+    return; // a star-shaped closed surface has no intersecting pair
   }
   std::pair<SizeValueType, SizeValueType> first;
-  const SizeValueType                     count = SurfaceCollision::CountSelfIntersections(
-    this->GetCoordinates().data(), triangles->data(), numberOfTriangles, &first);
+  const SizeValueType count = SurfaceCollision::CountSelfIntersections(this->GetCoordinates().data(),
+                                                                       triangles->data(),
+                                                                       numberOfTriangles,
+                                                                       &first,
+                                                                       this->GetMultiThreader(),
+                                                                       this->GetNumberOfWorkUnits());
   if (count > 0)
   {
     m_Collision.Clear();

@@ -1492,6 +1492,18 @@ public:
     return m_NumberOfRebuilds;
   }
 
+  /** The same two counts since this object was made (across SetSurface()). */
+  SizeValueType
+  GetTotalNumberOfRebuilds() const
+  {
+    return m_TotalNumberOfRebuilds;
+  }
+  SizeValueType
+  GetTotalNumberOfCertifiedSteps() const
+  {
+    return m_TotalNumberOfCertifiedSteps;
+  }
+
   /** Triangles whose candidate pairs the last Constrain() looked at (their
    * relative motion reached their clearance). */
   SizeValueType
@@ -2076,40 +2088,84 @@ public:
   /** Counts the pairs of triangles sharing no vertex that intersect
    * (TrianglesIntersect()); the first pair (lowest first triangle, then
    * lowest second) in \a first when not null ({-1, -1} when none).
-   * \a x: 3 doubles a point; \a triangles: 3 point indices each. */
+   * \a x: 3 doubles a point; \a triangles: 3 point indices each. A closed
+   * surface that the star-shaped certificate accepts (IsStarShaped()) has
+   * none, and is not searched; otherwise a grid of the triangles' boxes is
+   * searched, in parallel blocks when \a threader is given (the result does
+   * not depend on it). */
   static SizeValueType
   CountSelfIntersections(const double *                            x,
                          const IndexType *                         triangles,
                          SizeValueType                             numberOfTriangles,
-                         std::pair<SizeValueType, SizeValueType> * first = nullptr)
+                         std::pair<SizeValueType, SizeValueType> * first = nullptr,
+                         MultiThreaderBase *                       threader = nullptr,
+                         unsigned int                              workUnits = 1)
   {
-    std::vector<float> boxes(6 * numberOfTriangles);
-    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+    const auto                                   none = std::numeric_limits<SizeValueType>::max();
+    const SurfaceCollisionDetail::ParallelBlocks parallel{ threader, workUnits };
+    if (first != nullptr)
     {
-      double lo[3], hi[3];
-      TriangleBox(x, triangles + 3 * t, lo, hi);
-      SurfaceCollisionDetail::StoreBox(lo, hi, 0.0, boxes.data() + 6 * t);
+      *first = std::make_pair(none, none);
     }
+    if (numberOfTriangles >= 4)
+    {
+      SizeValueType numberOfPoints = 0;
+      for (SizeValueType i = 0; i < 3 * numberOfTriangles; ++i)
+      {
+        numberOfPoints = std::max<SizeValueType>(numberOfPoints, SizeValueType{ triangles[i] } + 1);
+      }
+      SurfaceCollision star;
+      star.SetSurface(numberOfPoints, triangles, numberOfTriangles, threader, workUnits);
+      if (star.StarShaped(x, parallel))
+      {
+        return 0;
+      }
+    }
+    std::vector<float> boxes(6 * numberOfTriangles);
+    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+      for (SizeValueType t = begin; t < end; ++t)
+      {
+        double lo[3], hi[3];
+        TriangleBox(x, triangles + 3 * t, lo, hi);
+        SurfaceCollisionDetail::StoreBox(lo, hi, 0.0, boxes.data() + 6 * t);
+      }
+    });
     SurfaceCollisionDetail::BoxGrid grid;
     grid.Build(boxes.data(), numberOfTriangles);
-    SizeValueType                           count = 0;
-    const auto                              none = std::numeric_limits<SizeValueType>::max();
-    std::pair<SizeValueType, SizeValueType> firstPair(none, none);
-    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+    // Per block of triangles: the count and the first pair.
+    using Pair = std::pair<SizeValueType, SizeValueType>;
+    constexpr SizeValueType                     block = SurfaceCollisionDetail::ParallelBlocks::Block;
+    std::vector<std::pair<SizeValueType, Pair>> blocks((numberOfTriangles + block - 1) / block,
+                                                       std::make_pair(SizeValueType{ 0 }, Pair(none, none)));
+    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+      auto & result = blocks[begin / block];
+      for (SizeValueType t = begin; t < end; ++t)
+      {
+        grid.ForEachOverlap(t, [&](SizeValueType u) {
+          if (u < t || SurfaceCollisionDetail::ShareVertex(triangles + 3 * t, triangles + 3 * u))
+          {
+            return;
+          }
+          const double * a[3] = { x + 3 * triangles[3 * t],
+                                  x + 3 * triangles[3 * t + 1],
+                                  x + 3 * triangles[3 * t + 2] };
+          const double * b[3] = { x + 3 * triangles[3 * u],
+                                  x + 3 * triangles[3 * u + 1],
+                                  x + 3 * triangles[3 * u + 2] };
+          if (SurfaceCollisionDetail::TrianglesIntersect(a, b))
+          {
+            ++result.first;
+            result.second = std::min(result.second, std::make_pair(t, u));
+          }
+        });
+      }
+    });
+    SizeValueType count = 0;
+    Pair          firstPair(none, none);
+    for (const auto & result : blocks)
     {
-      grid.ForEachOverlap(t, [&](SizeValueType u) {
-        if (u < t || SurfaceCollisionDetail::ShareVertex(triangles + 3 * t, triangles + 3 * u))
-        {
-          return;
-        }
-        const double * a[3] = { x + 3 * triangles[3 * t], x + 3 * triangles[3 * t + 1], x + 3 * triangles[3 * t + 2] };
-        const double * b[3] = { x + 3 * triangles[3 * u], x + 3 * triangles[3 * u + 1], x + 3 * triangles[3 * u + 2] };
-        if (SurfaceCollisionDetail::TrianglesIntersect(a, b))
-        {
-          ++count;
-          firstPair = std::min(firstPair, std::make_pair(t, u));
-        }
-      });
+      count += result.first;
+      firstPair = std::min(firstPair, result.second);
     }
     if (first != nullptr)
     {
@@ -2161,7 +2217,8 @@ public:
 
   /** Number of intersecting pairs of triangles sharing no vertex of a mesh
    * (itk::Mesh or any mesh with the same interface: triangles and
-   * fan-triangulated polygons), for quality reports. */
+   * fan-triangulated polygons), for quality reports; on the default
+   * number of threads. */
   template <typename TMesh>
   static SizeValueType
   CountSelfIntersections(const TMesh * mesh)
@@ -2177,7 +2234,14 @@ public:
         x.push_back(static_cast<double>(it.Value()[k]));
       }
     }
-    return CountSelfIntersections(x.data(), triangles.data(), triangles.size() / 3);
+    auto threader = MultiThreaderBase::New();
+    return CountSelfIntersections(x.data(),
+                                  triangles.data(),
+                                  triangles.size() / 3,
+                                  nullptr,
+                                  threader,
+                                  threader->GetMaximumNumberOfThreads() > 1 ? 4 * threader->GetMaximumNumberOfThreads()
+                                                                            : 1);
   }
 
 private:
@@ -2806,6 +2870,7 @@ private:
     {
       m_CertificateBackoff = 0;
       ++m_NumberOfCertifiedSteps;
+      ++m_TotalNumberOfCertifiedSteps;
       m_IndexValid = false;
       return true;
     }
@@ -2871,6 +2936,38 @@ private:
     // rounding turns the ray by about 1e-16 at most.
     const double length = scale + 1.0;
     const double target[3] = { centre[0] + length * ray[0], centre[1] + length * ray[1], centre[2] + length * ray[2] };
+    // Per point, once (a point is in about six triangles): its difference
+    // from the centre, as Orient3DSign(centre, a, b, e) rounds it, and on
+    // which side of the ray's line it lies, with the margin, along e1 (bit
+    // 1: above, bit 2: below) and e2 (bits 4, 8). A triangle whose three
+    // points share a bit lies strictly on one side and cannot meet the line.
+    // And the largest magnitude of the differences, S: each of the six
+    // products of the orientation determinant is at most S^3, which bounds
+    // its rounding error for all triangles at once (the filter of
+    // Orient3DFilteredSign() with 6 S^3 for the permanent).
+    m_StarDifferences.resize(3 * n);
+    m_StarSides.resize(n);
+    std::vector<double> largest((n + block - 1) / block, 0.0);
+    parallel(n, [&](SizeValueType begin, SizeValueType end) {
+      double m = 0.0;
+      for (SizeValueType i = begin; i < end; ++i)
+      {
+        double * q = m_StarDifferences.data() + 3 * i;
+        SurfaceCollisionDetail::Subtract(x + 3 * i, centre, q);
+        const double p1 = q[0] * e1[0] + q[1] * e1[1] + q[2] * e1[2];
+        const double p2 = q[0] * e2[0] + q[1] * e2[1] + q[2] * e2[2];
+        m_StarSides[i] = static_cast<uint8_t>((p1 > margin ? 1 : 0) | (p1 < -margin ? 2 : 0) | (p2 > margin ? 4 : 0) |
+                                              (p2 < -margin ? 8 : 0));
+        m = std::max({ m, std::abs(q[0]), std::abs(q[1]), std::abs(q[2]) });
+      }
+      largest[begin / block] = m;
+    });
+    const double magnitude = *std::max_element(largest.begin(), largest.end());
+    // 6 S^3 (1e-15 as in Orient3DFilteredSign()); infinite or not a number
+    // when S^3 overflows: then every sign goes to the exact test.
+    const double        sharedBound = 6e-15 * magnitude * magnitude * magnitude;
+    const double *      differences = m_StarDifferences.data();
+    const uint8_t *     sides = m_StarSides.data();
     const SizeValueType blocks = (numberOfTriangles + block - 1) / block;
     // Per block: positive and negative orientations, ray crossings, and
     // whether a sign was zero.
@@ -2880,18 +2977,21 @@ private:
       for (SizeValueType t = begin; t < end; ++t)
       {
         const IndexType * vt = m_Triangles.data() + 3 * t;
-        const double *    a = x + 3 * vt[0];
-        const double *    b = x + 3 * vt[1];
-        const double *    e = x + 3 * vt[2];
-        // The differences as Orient3DSign(centre, a, b, e) rounds them.
-        double q[3][3];
-        SurfaceCollisionDetail::Subtract(a, centre, q[0]);
-        SurfaceCollisionDetail::Subtract(b, centre, q[1]);
-        SurfaceCollisionDetail::Subtract(e, centre, q[2]);
-        int orientation = SurfaceCollisionDetail::Orient3DFilteredSign(q[0], q[1], q[2]);
+        const double *    q0 = differences + 3 * vt[0];
+        const double *    q1 = differences + 3 * vt[1];
+        const double *    q2 = differences + 3 * vt[2];
+        const double      m0 = q0[1] * q1[2] - q0[2] * q1[1];
+        const double      m1 = q0[2] * q1[0] - q0[0] * q1[2];
+        const double      m2 = q0[0] * q1[1] - q0[1] * q1[0];
+        const double      det = m0 * q2[0] + m1 * q2[1] + m2 * q2[2];
+        int               orientation = det > sharedBound ? 1 : (det < -sharedBound ? -1 : 0);
         if (orientation == 0)
         {
-          orientation = SurfaceCollisionDetail::Orient3DSign(centre, a, b, e);
+          orientation = SurfaceCollisionDetail::Orient3DFilteredSign(q0, q1, q2);
+        }
+        if (orientation == 0)
+        {
+          orientation = SurfaceCollisionDetail::Orient3DSign(centre, x + 3 * vt[0], x + 3 * vt[1], x + 3 * vt[2]);
         }
         if (orientation == 0)
         {
@@ -2899,18 +2999,13 @@ private:
           continue;
         }
         ++c[orientation > 0 ? 0 : 1];
-        double p1[3];
-        double p2[3];
-        for (unsigned int k = 0; k < 3; ++k)
-        {
-          p1[k] = q[k][0] * e1[0] + q[k][1] * e1[1] + q[k][2] * e1[2];
-          p2[k] = q[k][0] * e2[0] + q[k][1] * e2[1] + q[k][2] * e2[2];
-        }
-        if (std::min({ p1[0], p1[1], p1[2] }) > margin || std::max({ p1[0], p1[1], p1[2] }) < -margin ||
-            std::min({ p2[0], p2[1], p2[2] }) > margin || std::max({ p2[0], p2[1], p2[2] }) < -margin)
+        if ((sides[vt[0]] & sides[vt[1]] & sides[vt[2]]) != 0)
         {
           continue;
         }
+        const double * a = x + 3 * vt[0];
+        const double * b = x + 3 * vt[1];
+        const double * e = x + 3 * vt[2];
         // The ray's direction in the cone of the triangle seen from the
         // centre: its three coordinates in the cone's edges (Cramer) have
         // the sign of the orientation.
@@ -2965,6 +3060,7 @@ private:
     const SizeValueType numberOfTriangles = this->GetNumberOfTriangles();
     m_IndexValid = false;
     ++m_NumberOfRebuilds;
+    ++m_TotalNumberOfRebuilds;
     m_MinimumDistance = minimumDistance;
     double edges = 0.0;
     for (SizeValueType t = 0; t < numberOfTriangles; ++t)
@@ -4049,24 +4145,28 @@ private:
     m_SharedPairsReady = true;
   }
 
-  SizeValueType              m_NumberOfPoints{ 0 };
-  bool                       m_HasSurface{ false };
-  std::vector<IndexType>     m_Triangles;
-  std::vector<SizeValueType> m_VertexTriangleOffsets;
-  std::vector<IndexType>     m_VertexTriangles;
-  std::vector<IndexType>     m_SharedPairs;      // pairs sharing exactly one vertex: t, u (t < u)
-  std::vector<IndexType>     m_SharedOffsets;    // triangle -> range of m_SharedOfTriangle
-  std::vector<IndexType>     m_SharedOfTriangle; // the shared pairs each triangle is in
-  std::vector<IndexType>     m_SharedPartner;    // per entry of m_SharedOfTriangle, the other triangle
-  std::vector<float>         m_SharedGaps;       // per shared pair: a lower bound of its gap at the reference
-  std::vector<uint8_t>       m_SharedExact;      // per shared pair: the bound is the exact gap
-  std::vector<float>         m_SharedComputed;   // per shared pair: its bound when last computed (not carried)
+  SizeValueType m_NumberOfPoints{ 0 };
+  bool          m_HasSurface{ false };
+  // StarShaped()'s per-point differences and sides, kept between calls.
+  mutable std::vector<double>  m_StarDifferences;
+  mutable std::vector<uint8_t> m_StarSides;
+  std::vector<IndexType>       m_Triangles;
+  std::vector<SizeValueType>   m_VertexTriangleOffsets;
+  std::vector<IndexType>       m_VertexTriangles;
+  std::vector<IndexType>       m_SharedPairs;      // pairs sharing exactly one vertex: t, u (t < u)
+  std::vector<IndexType>       m_SharedOffsets;    // triangle -> range of m_SharedOfTriangle
+  std::vector<IndexType>       m_SharedOfTriangle; // the shared pairs each triangle is in
+  std::vector<IndexType>       m_SharedPartner;    // per entry of m_SharedOfTriangle, the other triangle
+  std::vector<float>           m_SharedGaps;       // per shared pair: a lower bound of its gap at the reference
+  std::vector<uint8_t>         m_SharedExact;      // per shared pair: the bound is the exact gap
+  std::vector<float>           m_SharedComputed;   // per shared pair: its bound when last computed (not carried)
 
   bool          m_Closed{ false };           // IsClosedSurface()
   bool          m_RepeatedPoint{ false };    // a triangle of SetSurface() repeats a point
   bool          m_SharedPairsReady{ false }; // EnsureSharedPairs() ran since SetSurface()
   bool          m_UseStarCertificate{ true };
   SizeValueType m_NumberOfCertifiedSteps{ 0 };
+  SizeValueType m_TotalNumberOfCertifiedSteps{ 0 };
   unsigned int  m_CertificateWait{ 0 };    // calls to skip before the next try
   unsigned int  m_CertificateBackoff{ 0 }; // the last wait
 
@@ -4076,6 +4176,7 @@ private:
   double                          m_ContactDistance{ 0.0 };
   double                          m_Radius{ 0.0 };
   SizeValueType                   m_NumberOfRebuilds{ 0 };
+  SizeValueType                   m_TotalNumberOfRebuilds{ 0 };
   SizeValueType                   m_NumberOfComputedSharedGaps{ 0 };
   std::vector<double>             m_Reference;
   std::vector<double>             m_Spheres; // per triangle at the reference: centre, radius

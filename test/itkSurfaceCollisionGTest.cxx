@@ -748,6 +748,17 @@ TEST(SurfaceCollision, CountsTheIntersectionsOfTwoOverlappingSpheres)
   EXPECT_EQ(count, all.intersecting) << "the grid finds every pair the all-pairs test finds";
   EXPECT_LT(first.first, first.second);
   EXPECT_GE(first.second, t2.size() / 3) << "one triangle of each sphere";
+  // The same count and first pair from parallel blocks (the two spheres are
+  // closed but not star-shaped: the grid is searched).
+  {
+    auto threader = itk::MultiThreaderBase::New();
+    threader->SetMaximumNumberOfThreads(2);
+    std::pair<itk::SizeValueType, itk::SizeValueType> parallelFirst;
+    EXPECT_EQ(
+      itk::SurfaceCollision::CountSelfIntersections(x.data(), t.data(), t.size() / 3, &parallelFirst, threader, 8),
+      count);
+    EXPECT_EQ(parallelFirst, first);
+  }
   // Apart (centres more than 10.5 apart): none.
   for (std::size_t i = offset; i < x.size() / 3; ++i)
   {
