@@ -1739,8 +1739,12 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
     }
     // The collision test's surface and index for the remeshed mesh, built
     // at its positions: the next step keeps the index.
-    m_Collision.SetSurface(
-      parents.size(), m_Triangles.data(), remeshedTriangles, this->GetMultiThreader(), this->GetNumberOfWorkUnits());
+    m_Collision.SetSurface(parents.size(),
+                           m_Triangles.data(),
+                           remeshedTriangles,
+                           this->GetMultiThreader(),
+                           this->GetNumberOfWorkUnits(),
+                           m_Remesher.IsOutputClosed());
     const SizeValueType found = m_Collision.FindContacts(
       x.data(), changed.data(), m_MinimumDistance, contacts, this->GetMultiThreader(), this->GetNumberOfWorkUnits());
     if (found == 0)
@@ -1794,7 +1798,8 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
                              m_Triangles.data(),
                              m_Triangles.size() / 3,
                              this->GetMultiThreader(),
-                             this->GetNumberOfWorkUnits());
+                             this->GetNumberOfWorkUnits(),
+                             m_Remesher.IsOutputClosed());
       break;
     }
   }

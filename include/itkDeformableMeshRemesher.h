@@ -177,6 +177,17 @@ public:
   bool
   Edges(std::vector<uint64_t> & edges) const;
 
+  /** Whether the last Remesh()'s output is a closed surface in the sense of
+   * SurfaceCollision::IsClosedSurface(): at least 4 triangles, and every
+   * directed edge (a, b) of a triangle is the edge (b, a) of exactly one
+   * other triangle and of no other triangle in the same direction (which
+   * excludes a triangle that repeats a point). Read from the corner table
+   * the remesher keeps: every corner has its twin. False before any
+   * Remesh(), after ForgetTable() and after a Remesh() with locked vertices
+   * (when the table is not kept): the caller then checks for itself. */
+  bool
+  IsOutputClosed() const;
+
   /** Whether the last Remesh() changed the connectivity (a split, collapse
    * or flip). When it did not, the points and triangles kept their numbers
    * and only positions moved (relaxation). */
@@ -1869,6 +1880,28 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
     m_TableValid = false; // its frozen states are not the mesh's
   }
   return m_Statistics;
+}
+
+inline bool
+DeformableMeshRemesher::IsOutputClosed() const
+{
+  const std::size_t numberOfCorners = m_V.size();
+  if (!m_TableValid || numberOfCorners < 12 || m_O.size() != numberOfCorners)
+  {
+    return false;
+  }
+  std::atomic<bool> closed{ true };
+  this->ParallelFor(numberOfCorners, [&](std::size_t first, std::size_t last) {
+    for (std::size_t c = first; c < last; ++c)
+    {
+      if (m_O[c] < 0)
+      {
+        closed = false;
+        return;
+      }
+    }
+  });
+  return closed;
 }
 
 inline std::vector<DeformableMeshRemesher::IndexType>

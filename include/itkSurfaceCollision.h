@@ -1314,13 +1314,19 @@ public:
    * Constrain() builds it. Call again whenever the mesh changes (remeshing,
    * renumbering). The tables of the pairs of triangles sharing one vertex
    * are made when the index first needs them: a surface accepted by the
-   * star-shaped certificate at every step never needs them. */
+   * star-shaped certificate at every step never needs them. \a knownClosed:
+   * the caller knows that the triangles form a closed surface
+   * (IsClosedSurface()'s condition), as DeformableMeshRemesher::
+   * IsOutputClosed() tells of a remeshing's output, and the check (a pass
+   * over the points, 60 % of this call on a sphere) is not made; a wrong
+   * claim would let the certificate accept positions it must not. */
   void
   SetSurface(SizeValueType       numberOfPoints,
              const IndexType *   triangles,
              SizeValueType       numberOfTriangles,
              MultiThreaderBase * threader = nullptr,
-             unsigned int        workUnits = 1)
+             unsigned int        workUnits = 1,
+             bool                knownClosed = false)
   {
     m_NumberOfPoints = numberOfPoints;
     m_Triangles.assign(triangles, triangles + 3 * numberOfTriangles);
@@ -1349,7 +1355,7 @@ public:
     });
     m_RepeatedPoint = std::find(blockDegenerate.begin(), blockDegenerate.end(), 1) != blockDegenerate.end();
     bool closed = numberOfTriangles >= 4 && !m_RepeatedPoint;
-    if (closed)
+    if (closed && !knownClosed)
     {
       std::vector<uint8_t> blockClosed((numberOfPoints + block - 1) / block, 1);
       parallel(numberOfPoints, [&](SizeValueType begin, SizeValueType end) {

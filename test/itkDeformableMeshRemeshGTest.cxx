@@ -21,6 +21,7 @@
 // contract with a changing mesh, the renumbering for locality.
 
 #include "itkDeformableMeshRemesher.h"
+#include "itkSurfaceCollision.h"
 #include "itkDeformableMeshFilter.h"
 #include "itkEllipsoidPhantom.h"
 #include "itkExternalForceImageFilter.h"
@@ -263,6 +264,16 @@ BoundaryOnSquare(const FlatMesh & m, double s, std::size_t & boundaryVertices)
   }
   return corners == 4;
 }
+
+// SurfaceCollision's own closedness check of a flat mesh, which the
+// remesher's IsOutputClosed() lets the filter skip: the two must agree.
+bool
+CollisionSaysClosed(const FlatMesh & m)
+{
+  itk::SurfaceCollision collision;
+  collision.SetSurface(m.Points(), m.triangles.data(), m.triangles.size() / 3);
+  return collision.IsClosedSurface();
+}
 } // namespace
 
 TEST(DeformableMeshRemesher, FlatOpenGridKeepsItsBoundaryExactly)
@@ -276,6 +287,8 @@ TEST(DeformableMeshRemesher, FlatOpenGridKeepsItsBoundaryExactly)
   {
     remesher.Remesh(m.x, m.Points(), m.triangles);
     ASSERT_EQ(remesher.Parents().size(), m.Points());
+    EXPECT_FALSE(remesher.IsOutputClosed()) << "an open grid";
+    EXPECT_FALSE(CollisionSaysClosed(m));
   }
   const Topology t = Analyse(m);
   EXPECT_EQ(t.badEdges, 0u);
@@ -313,6 +326,8 @@ TEST(DeformableMeshRemesher, ClosedSphereStaysAClosedTwoManifoldWithEdgesInTheBa
     for (int round = 0; round < 8; ++round)
     {
       remesher.Remesh(m.x, m.Points(), m.triangles);
+      EXPECT_TRUE(remesher.IsOutputClosed()) << target << ", round " << round;
+      EXPECT_TRUE(CollisionSaysClosed(m)) << target << ", round " << round;
       // The deformable model keeps the vertices on the surface; here the
       // projection onto the sphere does.
       for (std::size_t i = 0; i < m.Points(); ++i)
@@ -504,6 +519,19 @@ TEST(DeformableMeshRemesher, LeavesNonManifoldPartsAlone)
   EXPECT_EQ(statistics.splits + statistics.collapses + statistics.flips + statistics.relaxed, 0u);
   EXPECT_EQ(m.x, before.x);
   EXPECT_EQ(m.triangles, before.triangles);
+  EXPECT_FALSE(remesher.IsOutputClosed());
+  EXPECT_FALSE(CollisionSaysClosed(m));
+  // A closed surface with one triangle doubled (the same directed edges
+  // twice): not closed in IsClosedSurface()'s sense, nor for the remesher.
+  PointType centre;
+  centre.Fill(0.0);
+  FlatMesh doubled = ToFlat(itk::MakeSphereMesh<MeshType>(centre, 10.0, 2));
+  doubled.triangles.insert(doubled.triangles.end(), doubled.triangles.begin(), doubled.triangles.begin() + 3);
+  itk::DeformableMeshRemesher second;
+  second.SetTargetEdgeLength(1.0);
+  second.Remesh(doubled.x, doubled.Points(), doubled.triangles);
+  EXPECT_FALSE(second.IsOutputClosed());
+  EXPECT_FALSE(CollisionSaysClosed(doubled));
 }
 
 TEST(DeformableMeshRemesher, RejectsABadTargetOrMissingPoints)
