@@ -1730,12 +1730,30 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
       const IndexType32 p = parents[v];
       return x[3 * v] != before[3 * p] || x[3 * v + 1] != before[3 * p + 1] || x[3 * v + 2] != before[3 * p + 2];
     };
+    // In parallel, whether a point moved (2: none did, the input's
+    // triangles decide, below and in order).
     changed.assign(remeshedTriangles, 0);
+    constexpr SizeValueType block = 16384;
+    MultiThreaderBase *     threader = this->GetMultiThreader();
+    threader->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
+    threader->ParallelizeArray(
+      0,
+      (remeshedTriangles + block - 1) / block,
+      [&](SizeValueType b) {
+        for (SizeValueType t = b * block; t < std::min(remeshedTriangles, (b + 1) * block); ++t)
+        {
+          const IndexType32 * v = m_Triangles.data() + 3 * t;
+          changed[t] = moved(v[0]) || moved(v[1]) || moved(v[2]) ? 1 : 2;
+        }
+      },
+      nullptr);
     for (SizeValueType t = 0; t < remeshedTriangles; ++t)
     {
-      const IndexType32 * v = m_Triangles.data() + 3 * t;
-      changed[t] = moved(v[0]) || moved(v[1]) || moved(v[2]) ||
-                   !isInputTriangle(sorted(parents[v[0]], parents[v[1]], parents[v[2]]));
+      if (changed[t] == 2)
+      {
+        const IndexType32 * v = m_Triangles.data() + 3 * t;
+        changed[t] = isInputTriangle(sorted(parents[v[0]], parents[v[1]], parents[v[2]])) ? 0 : 1;
+      }
     }
     // The collision test's surface and index for the remeshed mesh, built
     // at its positions: the next step keeps the index.
