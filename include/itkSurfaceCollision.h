@@ -1438,7 +1438,9 @@ public:
    * exactly one triangle, none on its boundary. Then no two triangles
    * intersect and no two triangles of a fan fold into each other. False
    * when in doubt (a coordinate not finite, a zero sign, a ray through an
-   * edge). */
+   * edge). It keeps per-point work buffers in this object (kept between
+   * calls, so that a step allocates nothing): one call at a time per
+   * object. */
   bool
   IsStarShaped(const double * x, MultiThreaderBase * threader = nullptr, unsigned int workUnits = 1) const
   {
