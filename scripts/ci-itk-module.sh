@@ -32,10 +32,18 @@ run() {
   return "$rc"
 }
 
+# itk_tree VERSION [MODULE_SOURCE_DIR]: the ITK tree scripts/build-itk.sh
+# made (the last line it prints); stops the stage when it failed (its status
+# would be lost in a pipe: sh has no pipefail).
+itk_tree() {
+  out=$(scripts/build-itk.sh "$@") || { echo "ci-itk-module: scripts/build-itk.sh $* failed" >&2; exit 1; }
+  printf '%s\n' "$out" | tail -n 1
+}
+
 summary=""
 for version in "$@"; do
   start=$(date +%s)
-  itk=$(scripts/build-itk.sh "$version" | tail -n 1)
+  itk=$(itk_tree "$version")
   itk_built=$(date +%s)
 
   # 1. ITKModuleExternal. The VTK module and the benchmarks are the first
@@ -64,7 +72,7 @@ for version in "$@"; do
   tested=$(date +%s)
 
   # 2. Inside ITK's tree.
-  intree=$(scripts/build-itk.sh "$version" "$repo" | tail -n 1)
+  intree=$(itk_tree "$version" "$repo")
   demo="$build/intree-demo"
   rm -rf "$demo"
   "$intree/bin/edmodel" demo --output-dir "$demo"
