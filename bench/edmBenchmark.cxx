@@ -571,8 +571,10 @@ RunRemeshing(benchmark::State & state, bool collisions)
   model->SetNumberOfIterations(1);
   model->Update();
 
-  int64_t      vertexIterations = 0;
-  const double cpuStart = ProcessCPUSeconds();
+  int64_t                                  vertexIterations = 0;
+  const ModelType::RemeshingStatisticsType before = model->GetRemeshingStatistics();
+  const auto                               remeshingsBefore = model->GetNumberOfRemeshings();
+  const double                             cpuStart = ProcessCPUSeconds();
   for (auto _ : state)
   {
     const auto vertices = static_cast<int64_t>(model->GetOutput()->GetNumberOfPoints());
@@ -583,6 +585,14 @@ RunRemeshing(benchmark::State & state, bool collisions)
   SetCPUTimeCounter(state, ProcessCPUSeconds() - cpuStart, static_cast<double>(vertexIterations));
   state.counters["vertices"] = static_cast<double>(model->GetOutput()->GetNumberOfPoints());
   state.counters["remeshings"] = static_cast<double>(model->GetNumberOfRemeshings());
+  // The operations of an average remeshing of the measured updates: how much
+  // of the mesh each one rebuilds (the deformation keeps pulling edges out of
+  // the band).
+  const ModelType::RemeshingStatisticsType & after = model->GetRemeshingStatistics();
+  const double remeshings = std::max(1.0, static_cast<double>(model->GetNumberOfRemeshings() - remeshingsBefore));
+  state.counters["splits/remeshing"] = static_cast<double>(after.splits - before.splits) / remeshings;
+  state.counters["collapses/remeshing"] = static_cast<double>(after.collapses - before.collapses) / remeshings;
+  state.counters["flips/remeshing"] = static_cast<double>(after.flips - before.flips) / remeshings;
   if (collisions)
   {
     state.counters["collisions"] = static_cast<double>(model->GetTotalNumberOfCollisionsPrevented());

@@ -641,6 +641,15 @@ public:
   /** Number of remeshings since the last reset. */
   itkGetConstMacro(NumberOfRemeshings, SizeValueType);
 
+  /** The operations of the remeshings since the last reset, summed: edges
+   * split, collapsed and flipped, and vertices moved by the relaxation
+   * (DeformableMeshRemesher::Statistics; of a remeshing made again with
+   * points locked, the one kept). How much of the mesh each remeshing
+   * rebuilds: on a surface at rest few edges leave the band between two
+   * remeshings, on one whose vertices drift along it many do. */
+  using RemeshingStatisticsType = DeformableMeshRemesher::Statistics;
+  itkGetConstReferenceMacro(RemeshingStatistics, RemeshingStatisticsType);
+
   /** Points that the last remeshing left as they were because remeshing
    * their neighbourhood brought the surface into contact with itself
    * (PreventSelfIntersections on; see there). 0 when nothing was locked. */
@@ -907,6 +916,7 @@ private:
   bool                     m_Renumbered{ false };
   double                   m_FarEdgeFraction{ 0.0 };
   SizeValueType            m_NumberOfRemeshings{ 0 };
+  RemeshingStatisticsType  m_RemeshingStatistics;
   SizeValueType            m_NumberOfPointsLockedByRemeshing{ 0 };
   // The surface's triangles in the internal numbering (remeshing only).
   std::vector<IndexType32> m_Triangles;

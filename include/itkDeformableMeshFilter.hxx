@@ -928,6 +928,7 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
     std::vector<IndexType32>().swap(m_Triangles);
   }
   m_NumberOfRemeshings = 0;
+  m_RemeshingStatistics = RemeshingStatisticsType{};
   m_NumberOfPointsLockedByRemeshing = 0;
   m_Remesher.ForgetTable();
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
@@ -1612,6 +1613,11 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
   {
     m_Remesher.Remesh(x, numberOfPoints, m_Triangles);
   }
+  const RemeshingStatisticsType & last = m_Remesher.GetStatistics();
+  m_RemeshingStatistics.splits += last.splits;
+  m_RemeshingStatistics.collapses += last.collapses;
+  m_RemeshingStatistics.flips += last.flips;
+  m_RemeshingStatistics.relaxed += last.relaxed;
   if (!m_Remesher.GetTopologyChanged() && x.size() == 3 * numberOfPoints)
   {
     // Only positions moved (relaxation): the numbering, the cells, the
@@ -1878,6 +1884,9 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "RemeshingEdgeLength: " << m_RemeshingEdgeLength << std::endl;
   os << indent << "RemeshingInterval: " << m_RemeshingInterval << std::endl;
   os << indent << "NumberOfRemeshings: " << m_NumberOfRemeshings << std::endl;
+  os << indent << "RemeshingStatistics: " << m_RemeshingStatistics.splits << " splits, "
+     << m_RemeshingStatistics.collapses << " collapses, " << m_RemeshingStatistics.flips << " flips, "
+     << m_RemeshingStatistics.relaxed << " relaxed" << std::endl;
   os << indent << "NumberOfPointsLockedByRemeshing: " << m_NumberOfPointsLockedByRemeshing << std::endl;
   os << indent << "RenumberForLocality: " << (m_RenumberForLocality ? "On" : "Off") << std::endl;
   os << indent << "Renumbered: " << (m_Renumbered ? "true" : "false") << " (far edge fraction " << m_FarEdgeFraction

@@ -188,6 +188,13 @@ public:
   bool
   IsOutputClosed() const;
 
+  /** Counts of the operations of the last Remesh() (what it returned). */
+  const Statistics &
+  GetStatistics() const
+  {
+    return m_Statistics;
+  }
+
   /** Whether the last Remesh() changed the connectivity (a split, collapse
    * or flip). When it did not, the points and triangles kept their numbers
    * and only positions moved (relaxation). */

@@ -766,6 +766,61 @@ TEST(DeformableMeshRemeshing, ContinuationAbortAndResetGiveTheSameMeshAcrossReme
   EXPECT_TRUE(SameMesh(once->GetOutput(), c.sphere)) << "0 iterations: the input";
 }
 
+TEST(DeformableMeshRemeshing, StatisticsAreThoseOfTheRemesherOnTheSameMesh)
+{
+  // No force moves a point (ScaleFactor, Elasticity, Rigidity and Balloon
+  // 0), so the remeshing after iteration 10 sees the input as it is: its
+  // operations are those of a DeformableMeshRemesher on the input's points
+  // and triangles, and the output is that remesher's mesh.
+  const ElongatedCase & c = Elongated();
+  constexpr double      target = 0.6; // the sphere's edges are about 1: many splits
+  auto                  filter = c.MakeFilter(target, 10);
+  filter->SetScaleFactor(0.0);
+  filter->SetElasticity(0.0);
+  filter->SetRigidity(0.0);
+  filter->SetBalloon(0.0);
+  filter->SetRenumberForLocality(false);
+  EXPECT_EQ(filter->GetRemeshingStatistics().splits, 0u);
+  filter->Update();
+  ASSERT_EQ(filter->GetNumberOfRemeshings(), 1u);
+
+  FlatMesh                    input = ToFlat(c.sphere);
+  itk::DeformableMeshRemesher remesher;
+  remesher.SetTargetEdgeLength(target);
+  const itk::DeformableMeshRemesher::Statistics expected = remesher.Remesh(input.x, input.Points(), input.triangles);
+  const auto &                                  statistics = filter->GetRemeshingStatistics();
+  EXPECT_GT(expected.splits, 1000u);
+  EXPECT_EQ(statistics.splits, expected.splits);
+  EXPECT_EQ(statistics.collapses, expected.collapses);
+  EXPECT_EQ(statistics.flips, expected.flips);
+  EXPECT_EQ(statistics.relaxed, expected.relaxed);
+  // The output mesh's points hold the remesher's coordinates in its
+  // coordinate type (float for itk::Mesh's default traits).
+  const FlatMesh output = OutputOf(filter);
+  EXPECT_EQ(output.triangles, input.triangles);
+  std::vector<double> rounded(input.x.size());
+  std::transform(input.x.begin(), input.x.end(), rounded.begin(), [](double v) {
+    return static_cast<double>(static_cast<PointType::ValueType>(v));
+  });
+  EXPECT_EQ(output.x, rounded);
+
+  // Summed over the remeshings, and started again at a reset.
+  filter->SetIterateFromZero(false);
+  filter->SetNumberOfIterations(20);
+  filter->Update();
+  ASSERT_EQ(filter->GetNumberOfRemeshings(), 2u);
+  const itk::DeformableMeshRemesher::Statistics second = remesher.Remesh(input.x, input.Points(), input.triangles);
+  EXPECT_EQ(statistics.splits, expected.splits + second.splits);
+  EXPECT_EQ(statistics.collapses, expected.collapses + second.collapses);
+  EXPECT_EQ(statistics.flips, expected.flips + second.flips);
+  EXPECT_EQ(statistics.relaxed, expected.relaxed + second.relaxed);
+  filter->SetIterateFromZero(true);
+  filter->SetNumberOfIterations(5);
+  filter->Update();
+  EXPECT_EQ(filter->GetNumberOfRemeshings(), 0u);
+  EXPECT_EQ(statistics.splits + statistics.collapses + statistics.flips + statistics.relaxed, 0u);
+}
+
 TEST(DeformableMeshRemeshing, RejectsABadEdgeLengthIntervalOrCells)
 {
   const ElongatedCase & c = Elongated();
