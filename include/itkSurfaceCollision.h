@@ -1262,6 +1262,20 @@ struct ParallelBlocks
  * surface that is not star-shaped pays for it on at most one step in 64.
  * SetUseStarShapedCertificate(false) turns it off.
  *
+ * The certificate also takes a surface that is star-shaped but for a few
+ * folds (IsStarShapedUpToFolds()), as a remeshing or a step leaves on a
+ * surface of fine triangles: at most MaximumFoldTriangles triangles face
+ * the other way from c, and the ray's crossings, counted with the signs of
+ * their triangles' orientations, still sum to the orientation of the
+ * others (the degree of the projection is 1). A direction from c that no
+ * fold's projection covers is then covered by exactly one triangle, so two
+ * triangles can only meet where both project next to a fold: the triangles
+ * whose caps of directions meet a fold's cap (at most
+ * MaximumFoldNeighbourhood) are tested pair by pair with the exact
+ * predicates (TrianglesIntersect(), SharedVertexGap()). One more pass over
+ * the triangles, and a few thousand pair tests, where the index would be
+ * built (3 s for a million points).
+ *
  * CountSelfIntersections() counts the intersecting pairs of a surface with
  * a grid of exact triangle boxes.
  *
@@ -1446,6 +1460,20 @@ public:
   {
     const SurfaceCollisionDetail::ParallelBlocks parallel{ threader, workUnits };
     return this->StarShaped(x, parallel);
+  }
+
+  /** The certificate that the collision test uses (class documentation):
+   * IsStarShaped(), or star-shaped but for at most MaximumFoldTriangles
+   * triangles facing the other way, whose neighbourhood (the triangles
+   * whose projections from the centroid come near theirs, at most
+   * MaximumFoldNeighbourhood) has no intersecting pair and no fan folded
+   * into itself, tested pair by pair. True only when no two triangles
+   * intersect; false when in doubt. One call at a time per object. */
+  bool
+  IsStarShapedUpToFolds(const double * x, MultiThreaderBase * threader = nullptr, unsigned int workUnits = 1) const
+  {
+    const SurfaceCollisionDetail::ParallelBlocks parallel{ threader, workUnits };
+    return this->StarShapedUpToFolds(x, parallel);
   }
 
   /** Forgets the connectivity and the index. */
@@ -2874,7 +2902,7 @@ private:
       --m_CertificateWait;
       return false;
     }
-    if (this->StarShaped(y, parallel))
+    if (this->StarShapedUpToFolds(y, parallel))
     {
       m_CertificateBackoff = 0;
       ++m_NumberOfCertifiedSteps;
@@ -2887,10 +2915,26 @@ private:
     return false;
   }
 
-  /** IsStarShaped(), with the passes run by \a parallel. */
+  /** What StarShaped() found: the numbers of triangles of each strict
+   * orientation seen from the centre, the ray's crossings of each, and
+   * whether a sign was zero or the ray met an edge (then nothing else is
+   * known). */
+  struct StarSummary
+  {
+    SizeValueType positive{ 0 };
+    SizeValueType negative{ 0 };
+    SizeValueType positiveCrossings{ 0 };
+    SizeValueType negativeCrossings{ 0 };
+    bool          undecided{ true };
+    double        centre[3]{ 0.0, 0.0, 0.0 };
+    double        sharedBound{ 0.0 }; // StarOrientation()'s bound
+  };
+
+  /** IsStarShaped(), with the passes run by \a parallel; what it found in
+   * \a summary when not null. */
   template <typename TParallel>
   bool
-  StarShaped(const double * x, TParallel && parallel) const
+  StarShaped(const double * x, TParallel && parallel, StarSummary * summary = nullptr) const
   {
     const SizeValueType n = m_NumberOfPoints;
     const SizeValueType numberOfTriangles = this->GetNumberOfTriangles();
@@ -2977,30 +3021,16 @@ private:
     const double *      differences = m_StarDifferences.data();
     const uint8_t *     sides = m_StarSides.data();
     const SizeValueType blocks = (numberOfTriangles + block - 1) / block;
-    // Per block: positive and negative orientations, ray crossings, and
-    // whether a sign was zero.
-    std::vector<std::array<SizeValueType, 4>> counts(blocks, std::array<SizeValueType, 4>{ { 0, 0, 0, 0 } });
+    // Per block: positive and negative orientations, ray crossings (of
+    // positive triangles, then of negative ones), and whether a sign was
+    // zero.
+    std::vector<std::array<SizeValueType, 5>> counts(blocks, std::array<SizeValueType, 5>{ { 0, 0, 0, 0, 0 } });
     parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
       auto & c = counts[begin / block];
       for (SizeValueType t = begin; t < end; ++t)
       {
         const IndexType * vt = m_Triangles.data() + 3 * t;
-        const double *    q0 = differences + 3 * vt[0];
-        const double *    q1 = differences + 3 * vt[1];
-        const double *    q2 = differences + 3 * vt[2];
-        const double      m0 = q0[1] * q1[2] - q0[2] * q1[1];
-        const double      m1 = q0[2] * q1[0] - q0[0] * q1[2];
-        const double      m2 = q0[0] * q1[1] - q0[1] * q1[0];
-        const double      det = m0 * q2[0] + m1 * q2[1] + m2 * q2[2];
-        int               orientation = det > sharedBound ? 1 : (det < -sharedBound ? -1 : 0);
-        if (orientation == 0)
-        {
-          orientation = SurfaceCollisionDetail::Orient3DFilteredSign(q0, q1, q2);
-        }
-        if (orientation == 0)
-        {
-          orientation = SurfaceCollisionDetail::Orient3DSign(centre, x + 3 * vt[0], x + 3 * vt[1], x + 3 * vt[2]);
-        }
+        const int         orientation = StarOrientation(x, differences, vt, centre, sharedBound);
         if (orientation == 0)
         {
           ++c[3];
@@ -3022,7 +3052,7 @@ private:
         const int s3 = SurfaceCollisionDetail::Orient3DSign(centre, a, b, target);
         if (s1 == orientation && s2 == orientation && s3 == orientation)
         {
-          ++c[2];
+          ++c[orientation > 0 ? 2 : 4];
         }
         else if ((s1 == 0 || s1 == orientation) && (s2 == 0 || s2 == orientation) && (s3 == 0 || s3 == orientation))
         {
@@ -3030,20 +3060,242 @@ private:
         }
       }
     });
-    SizeValueType positive = 0;
-    SizeValueType negative = 0;
-    SizeValueType crossings = 0;
+    StarSummary found;
+    std::copy(centre, centre + 3, found.centre);
+    found.sharedBound = sharedBound;
+    found.undecided = false;
     for (const auto & c : counts)
     {
-      if (c[3] > 0)
+      found.undecided = found.undecided || c[3] > 0;
+      found.positive += c[0];
+      found.negative += c[1];
+      found.positiveCrossings += c[2];
+      found.negativeCrossings += c[4];
+    }
+    if (summary != nullptr)
+    {
+      *summary = found;
+    }
+    return !found.undecided && (found.positive == 0 || found.negative == 0) &&
+           found.positiveCrossings + found.negativeCrossings == 1;
+  }
+
+  /** The certificate of a surface star-shaped but for a few folds (class
+   * documentation): StarShaped(), or, when it fails only because at most
+   * MaximumFoldTriangles triangles face the other way from the centre and
+   * the signed crossings of the ray sum to the orientation of the others
+   * (the degree of the central projection is still 1), the exact test of
+   * every pair of triangles whose projections from the centre come near
+   * those of the folds (at most MaximumFoldNeighbourhood triangles): no two
+   * sharing no point intersect (TrianglesIntersect()), no two sharing one
+   * point fold into each other (SharedVertexGap() 0). Every other direction
+   * from the centre is covered by exactly one triangle (positive minus
+   * negative coverings is the degree, and no negative triangle covers it),
+   * so no other pair can meet. False when in doubt. */
+  template <typename TParallel>
+  bool
+  StarShapedUpToFolds(const double * x, TParallel && parallel) const
+  {
+    using SurfaceCollisionDetail::Dot;
+    StarSummary summary;
+    if (this->StarShaped(x, parallel, &summary))
+    {
+      return true;
+    }
+    const int           majority = summary.positive >= summary.negative ? 1 : -1;
+    const SizeValueType minority = majority > 0 ? summary.negative : summary.positive;
+    const auto          degree =
+      static_cast<int64_t>(summary.positiveCrossings) - static_cast<int64_t>(summary.negativeCrossings);
+    if (summary.undecided || minority == 0 || minority > MaximumFoldTriangles || degree != majority)
+    {
+      return false;
+    }
+    const SizeValueType     numberOfTriangles = this->GetNumberOfTriangles();
+    const double *          differences = m_StarDifferences.data();
+    const double *          centre = summary.centre;
+    constexpr SizeValueType block = SurfaceCollisionDetail::ParallelBlocks::Block;
+    const SizeValueType     blocks = (numberOfTriangles + block - 1) / block;
+    // The cone of a triangle seen from the centre lies in the cap around
+    // the unit sum of its corners' directions through the farthest corner
+    // (a cap of less than a quarter sphere is convex on the sphere). Caps
+    // of more than 84 degrees are taken as meeting everything.
+    constexpr double widest = 0.1; // cosine of the widest cap measured
+    const auto       cap = [differences](const IndexType * vt, double axis[3]) {
+      double u[3][3];
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        const double * q = differences + 3 * static_cast<SizeValueType>(vt[k]);
+        const double   length = std::sqrt(Dot(q, q));
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          u[k][d] = q[d] / length;
+        }
+      }
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        axis[d] = u[0][d] + u[1][d] + u[2][d];
+      }
+      const double length = std::sqrt(Dot(axis, axis));
+      if (!(length > 0.0))
+      {
+        return -1.0;
+      }
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        axis[d] /= length;
+      }
+      return std::min({ Dot(axis, u[0]), Dot(axis, u[1]), Dot(axis, u[2]) });
+    };
+    // The folds (the triangles of the minority orientation) and their caps,
+    // widened by 1e-6 radians for the rounding of these products.
+    std::vector<std::vector<IndexType>> parts(blocks);
+    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+      for (SizeValueType t = begin; t < end; ++t)
+      {
+        if (StarOrientation(x, differences, m_Triangles.data() + 3 * t, centre, summary.sharedBound) == -majority)
+        {
+          parts[begin / block].push_back(static_cast<IndexType>(t));
+        }
+      }
+    });
+    std::vector<std::array<double, 5>> folds; // axis, cosine and sine of the radius
+    for (const auto & part : parts)
+    {
+      for (const IndexType t : part)
+      {
+        std::array<double, 5> f;
+        const double          cosine = cap(m_Triangles.data() + 3 * static_cast<SizeValueType>(t), f.data());
+        if (!(cosine >= widest))
+        {
+          return false;
+        }
+        const double radius = std::acos(std::min(1.0, cosine)) + 1e-6;
+        f[3] = std::cos(radius);
+        f[4] = std::sin(radius);
+        folds.push_back(f);
+      }
+    }
+    // The triangles whose caps meet a fold's cap (the folds among them).
+    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+      auto & part = parts[begin / block];
+      part.clear();
+      for (SizeValueType t = begin; t < end; ++t)
+      {
+        double       axis[3];
+        const double cosine = cap(m_Triangles.data() + 3 * t, axis);
+        bool         near = !(cosine >= widest);
+        if (!near)
+        {
+          const double sine = std::sqrt(std::max(0.0, 1.0 - cosine * cosine));
+          for (const auto & f : folds)
+          {
+            // The angle between the axes at most the sum of the radii.
+            if (Dot(axis, f.data()) >= cosine * f[3] - sine * f[4])
+            {
+              near = true;
+              break;
+            }
+          }
+        }
+        if (near)
+        {
+          part.push_back(static_cast<IndexType>(t));
+        }
+      }
+    });
+    std::vector<IndexType> nearby;
+    for (const auto & part : parts)
+    {
+      nearby.insert(nearby.end(), part.begin(), part.end());
+      if (nearby.size() > MaximumFoldNeighbourhood)
       {
         return false;
       }
-      positive += c[0];
-      negative += c[1];
-      crossings += c[2];
     }
-    return (positive == 0 || negative == 0) && crossings == 1;
+    // Every pair of them, exactly (boxes first).
+    const SizeValueType count = nearby.size();
+    std::vector<double> boxes(6 * count);
+    for (SizeValueType k = 0; k < count; ++k)
+    {
+      const IndexType * vt = m_Triangles.data() + 3 * static_cast<SizeValueType>(nearby[k]);
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        boxes[6 * k + d] = std::min({ x[3 * vt[0] + d], x[3 * vt[1] + d], x[3 * vt[2] + d] });
+        boxes[6 * k + 3 + d] = std::max({ x[3 * vt[0] + d], x[3 * vt[1] + d], x[3 * vt[2] + d] });
+      }
+    }
+    for (SizeValueType k = 0; k < count; ++k)
+    {
+      const IndexType * vt = m_Triangles.data() + 3 * static_cast<SizeValueType>(nearby[k]);
+      const double *    a[3] = { x + 3 * vt[0], x + 3 * vt[1], x + 3 * vt[2] };
+      for (SizeValueType l = k + 1; l < count; ++l)
+      {
+        const double * bk = boxes.data() + 6 * k;
+        const double * bl = boxes.data() + 6 * l;
+        if (bk[0] > bl[3] || bl[0] > bk[3] || bk[1] > bl[4] || bl[1] > bk[4] || bk[2] > bl[5] || bl[2] > bk[5])
+        {
+          continue;
+        }
+        const IndexType * vu = m_Triangles.data() + 3 * static_cast<SizeValueType>(nearby[l]);
+        const double *    b[3] = { x + 3 * vu[0], x + 3 * vu[1], x + 3 * vu[2] };
+        unsigned int      shared = 0;
+        unsigned int      i = 0;
+        unsigned int      j = 0;
+        for (unsigned int p = 0; p < 3; ++p)
+        {
+          for (unsigned int q = 0; q < 3; ++q)
+          {
+            if (vt[p] == vu[q])
+            {
+              ++shared;
+              i = p;
+              j = q;
+            }
+          }
+        }
+        if ((shared == 0 && SurfaceCollisionDetail::TrianglesIntersect(a, b)) ||
+            (shared == 1 && SurfaceCollisionDetail::SharedVertexGap(a, i, b, j) == 0.0))
+        {
+          return false;
+        }
+      }
+    }
+    return true;
+  }
+
+  /** StarShapedUpToFolds()'s limits: the triangles facing the other way,
+   * and the triangles near them whose pairs are tested. */
+  static constexpr SizeValueType MaximumFoldTriangles = 256;
+  static constexpr SizeValueType MaximumFoldNeighbourhood = 4096;
+
+  /** The orientation of triangle \a vt seen from \a centre, from
+   * StarShaped()'s \a differences (x - centre, rounded) and its bound of
+   * their rounding: 1, -1, or 0 when the centre lies in the triangle's
+   * plane (exact sign). */
+  static int
+  StarOrientation(const double *    x,
+                  const double *    differences,
+                  const IndexType * vt,
+                  const double *    centre,
+                  double            sharedBound)
+  {
+    const double * q0 = differences + 3 * vt[0];
+    const double * q1 = differences + 3 * vt[1];
+    const double * q2 = differences + 3 * vt[2];
+    const double   m0 = q0[1] * q1[2] - q0[2] * q1[1];
+    const double   m1 = q0[2] * q1[0] - q0[0] * q1[2];
+    const double   m2 = q0[0] * q1[1] - q0[1] * q1[0];
+    const double   det = m0 * q2[0] + m1 * q2[1] + m2 * q2[2];
+    int            orientation = det > sharedBound ? 1 : (det < -sharedBound ? -1 : 0);
+    if (orientation == 0)
+    {
+      orientation = SurfaceCollisionDetail::Orient3DFilteredSign(q0, q1, q2);
+    }
+    if (orientation == 0)
+    {
+      orientation = SurfaceCollisionDetail::Orient3DSign(centre, x + 3 * vt[0], x + 3 * vt[1], x + 3 * vt[2]);
+    }
+    return orientation;
   }
 
   /** m as a float not above it. */
