@@ -949,14 +949,26 @@ DeformableMeshRemesher::SplitPass(bool all)
       [&](std::size_t first, std::size_t last) {
         std::vector<std::pair<double, IndexType>> & part = parts[first / blockSize];
         uint64_t                                    bits = 0;
-        for (std::size_t c = first; c < last; ++c)
+        // consider() and ShortEdge() in one, without branches on which
+        // corner lists an edge (half of them, in no order a predictor
+        // follows): each corner's length, the end-points' states only for
+        // the long edges, Next() counted along.
+        std::size_t k = first % 3;
+        for (std::size_t c = first; c < last; ++c, k = k == 2 ? 0 : k + 1)
         {
-          const Link o = m_O[c];
-          if (o < 0 || o > static_cast<int64_t>(c))
+          const IndexType a = m_V[c];
+          const Link      o = m_O[c];
+          const bool      valid = a != Invalid;
+          const IndexType b = m_V[k == 2 ? c - 2 : c + 1];
+          const double    length2 = this->Length2(valid ? a : 0, valid ? b : 0);
+          const bool      above = o > static_cast<int64_t>(c);
+          const bool      listed = valid & ((o < 0) | above);
+          if (length2 > m_Max2 && listed && o != NonManifold && m_State[a] != RemesherFrozen &&
+              m_State[b] != RemesherFrozen)
           {
-            consider(static_cast<IndexType>(c), part);
+            part.emplace_back(length2, static_cast<IndexType>(c));
           }
-          bits |= static_cast<uint64_t>(this->ShortEdge(static_cast<IndexType>(c))) << (c & 63);
+          bits |= static_cast<uint64_t>(valid & above & (length2 < m_Min2)) << (c & 63);
           if ((c & 63) == 63 || c + 1 == last)
           {
             m_ShortEdges[c >> 6] = bits;
