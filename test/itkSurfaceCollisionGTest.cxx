@@ -851,6 +851,31 @@ Inflate(const std::vector<double> & x, double grow, unsigned int step)
   }
   return y;
 }
+
+/** StarSphere()'s points with point 0 pushed through the sphere, to 1.5
+ * times its radius on the other side: intersecting. */
+std::vector<double>
+PushedThrough(const std::vector<double> & x)
+{
+  std::vector<double> y = x;
+  const double        centre[3] = { 1.3, -0.7, 2.1 };
+  for (unsigned int k = 0; k < 3; ++k)
+  {
+    y[k] = centre[k] - 1.5 * (x[k] - centre[k]);
+  }
+  return y;
+}
+
+/** StarSphere()'s points with point 0 pulled sideways until one of its
+ * triangles turns its back to the centre, without intersecting: a fold. */
+std::vector<double>
+Leaning(const std::vector<double> & x)
+{
+  std::vector<double> y = x;
+  y[0] += 4.0;
+  y[1] += 4.0;
+  return y;
+}
 } // namespace
 
 TEST(SurfaceCollision, TheStarShapedCertificateKnowsItsSurfaces)
@@ -876,21 +901,13 @@ TEST(SurfaceCollision, TheStarShapedCertificateKnowsItsSurfaces)
   EXPECT_TRUE(turned.IsStarShaped(bumped.data()));
 
   // Point 0 pushed through the sphere: intersecting, not certified.
-  std::vector<double> folded = x;
-  for (unsigned int k = 0; k < 3; ++k)
-  {
-    const double centre = k == 0 ? 1.3 : (k == 1 ? -0.7 : 2.1);
-    folded[k] = centre - 1.5 * (x[k] - centre);
-  }
+  const std::vector<double> folded = PushedThrough(x);
   ASSERT_GT(CheckAllPairs(folded, triangles, 0.0).intersecting, 0u);
   EXPECT_FALSE(collision.IsStarShaped(folded.data()));
   // Point 0 pulled sideways until one of its triangles turns its back to
   // the centre, without intersecting: not star-shaped from the centroid,
   // not certified (the index decides).
-  std::vector<double> leaning = x;
-  leaning[0] += 4.0;
-  leaning[1] += 4.0;
-  EXPECT_FALSE(collision.IsStarShaped(leaning.data()));
+  EXPECT_FALSE(collision.IsStarShaped(Leaning(x).data()));
 
   // Two spheres, one inside the other, both turned outward: every triangle
   // faces away from the centre, but a ray crosses two: not certified.
@@ -983,21 +1000,13 @@ TEST(SurfaceCollision, TheCertificateTakesFoldsThatMeetNothing)
   // Point 0 pulled sideways until one of its triangles turns its back to
   // the centre, without intersecting: not star-shaped, but the fold's
   // neighbourhood has no meeting pair.
-  std::vector<double> leaning = x;
-  leaning[0] += 4.0;
-  leaning[1] += 4.0;
+  const std::vector<double> leaning = Leaning(x);
   ASSERT_EQ(CheckAllPairs(leaning, triangles, 0.0).intersecting, 0u);
   ASSERT_EQ(CountFoldedFans(leaning, triangles), 0u);
   EXPECT_FALSE(collision.IsStarShaped(leaning.data()));
   EXPECT_TRUE(collision.IsStarShapedUpToFolds(leaning.data()));
   // Point 0 pushed through the sphere: refused.
-  std::vector<double> folded = x;
-  for (unsigned int k = 0; k < 3; ++k)
-  {
-    const double centre = k == 0 ? 1.3 : (k == 1 ? -0.7 : 2.1);
-    folded[k] = centre - 1.5 * (x[k] - centre);
-  }
-  EXPECT_FALSE(collision.IsStarShapedUpToFolds(folded.data()));
+  EXPECT_FALSE(collision.IsStarShapedUpToFolds(PushedThrough(x).data()));
 
   // One to three points thrown by up to 6 (the radius is 5): every surface
   // the certificate takes has no intersecting pair and no folded fan (both
@@ -1098,15 +1107,7 @@ TEST(SurfaceCollision, AfterAFailureTheCertificateWaitsLongerEachTime)
   itk::SurfaceCollision collision;
   collision.SetSurface(x.size() / 3, triangles.data(), triangles.size() / 3);
   const auto step = [&](bool crossing) {
-    std::vector<double> y = x;
-    if (crossing)
-    {
-      for (unsigned int k = 0; k < 3; ++k)
-      {
-        const double centre = k == 0 ? 1.3 : (k == 1 ? -0.7 : 2.1);
-        y[k] = centre - 1.5 * (x[k] - centre);
-      }
-    }
+    std::vector<double>      y = crossing ? PushedThrough(x) : x;
     const itk::SizeValueType before = collision.GetNumberOfCertifiedSteps();
     collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1);
     return collision.GetNumberOfCertifiedSteps() > before;
