@@ -1344,8 +1344,10 @@ public:
   {
     m_NumberOfPoints = numberOfPoints;
     m_Triangles.assign(triangles, triangles + 3 * numberOfTriangles);
-    // Per point, the triangles that use it.
-    GroupsOfKeys(m_Triangles, 3, numberOfPoints, m_VertexTriangleOffsets, m_VertexTriangles);
+    // Per point, the triangles that use it: made when first needed (the
+    // closed-surface check below, the constraint of a step the certificate
+    // does not accept, the index's shared pairs).
+    m_VertexTrianglesReady = false;
     // Whether a triangle repeats a point, and whether the surface is closed
     // (IsClosedSurface()): each directed edge (a, b) of a triangle is in no
     // other triangle of a's in that direction and in exactly one in the
@@ -1371,6 +1373,7 @@ public:
     bool closed = numberOfTriangles >= 4 && !m_RepeatedPoint;
     if (closed && !knownClosed)
     {
+      this->EnsureVertexTriangles();
       std::vector<uint8_t> blockClosed((numberOfPoints + block - 1) / block, 1);
       parallel(numberOfPoints, [&](SizeValueType begin, SizeValueType end) {
         std::vector<IndexType> after;
@@ -1999,6 +2002,10 @@ public:
     if (!violating.empty() && !sweptGridBuilt)
     {
       sweptBounded = this->Bound(y, parallel, x) == BoundStatus::Bounded;
+    }
+    if (!violating.empty())
+    {
+      this->EnsureVertexTriangles(); // the triangles of the points held back
     }
     while (!violating.empty())
     {
@@ -4290,9 +4297,22 @@ private:
     c[3] = std::sqrt(r2) * (1.0 + 1e-12);
   }
 
+  /** Per point, the triangles that use it (a CSR table, each point's
+   * triangles in increasing order), made once per SetSurface() when first
+   * needed. Not thread-safe: called before the parallel loops that read it. */
+  void
+  EnsureVertexTriangles()
+  {
+    if (!m_VertexTrianglesReady)
+    {
+      GroupsOfKeys(m_Triangles, 3, m_NumberOfPoints, m_VertexTriangleOffsets, m_VertexTriangles);
+      m_VertexTrianglesReady = true;
+    }
+  }
+
   /** Around point a, the other two points of each triangle of its fan
    * (in the order of the fan's list), as (a, after, before) in the
-   * triangle's own order. */
+   * triangle's own order. EnsureVertexTriangles() must have run. */
   void
   FanNeighbours(SizeValueType a, std::vector<IndexType> & after, std::vector<IndexType> & before) const
   {
@@ -4321,6 +4341,7 @@ private:
     {
       return;
     }
+    this->EnsureVertexTriangles();
     const SizeValueType                 numberOfPoints = m_NumberOfPoints;
     const SizeValueType                 numberOfTriangles = this->GetNumberOfTriangles();
     constexpr SizeValueType             block = SurfaceCollisionDetail::ParallelBlocks::Block;
@@ -4421,9 +4442,10 @@ private:
   std::vector<uint8_t>         m_SharedExact;      // per shared pair: the bound is the exact gap
   std::vector<float>           m_SharedComputed;   // per shared pair: its bound when last computed (not carried)
 
-  bool          m_Closed{ false };           // IsClosedSurface()
-  bool          m_RepeatedPoint{ false };    // a triangle of SetSurface() repeats a point
-  bool          m_SharedPairsReady{ false }; // EnsureSharedPairs() ran since SetSurface()
+  bool          m_Closed{ false };               // IsClosedSurface()
+  bool          m_RepeatedPoint{ false };        // a triangle of SetSurface() repeats a point
+  bool          m_SharedPairsReady{ false };     // EnsureSharedPairs() ran since SetSurface()
+  bool          m_VertexTrianglesReady{ false }; // EnsureVertexTriangles() ran since SetSurface()
   bool          m_UseStarCertificate{ true };
   SizeValueType m_NumberOfCertifiedSteps{ 0 };
   SizeValueType m_TotalNumberOfCertifiedSteps{ 0 };
