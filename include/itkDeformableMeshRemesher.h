@@ -142,6 +142,30 @@ public:
     m_WorkUnits = workUnits;
   }
 
+  /** The collapse, flip and lengthening passes of a mesh of at least
+   * 2 PartitionSize points run in parts: 2, 4 or 8 ranges of the input's
+   * point numbers of at least PartitionSize points each (a point split from
+   * an edge during the Remesh() belongs to the part of the point it comes
+   * from). Each part makes, in parallel with the others, its operations
+   * that read and change only its own points and the triangles among them,
+   * in corner order; the operations that would reach another part's point
+   * are made afterwards, in corner order, on the whole mesh. The result
+   * depends on the number of parts (on the mesh and PartitionSize), not on
+   * the threads; it differs from the serial sweep's only in the order of the
+   * operations. A numbering for locality (LocalityOrder(), or the output of
+   * a Remesh()) keeps the operations across parts few. 0: every pass one
+   * serial sweep in corner order. Default: 8192. */
+  void
+  SetPartitionSize(std::size_t points)
+  {
+    m_PartitionSize = points;
+  }
+  std::size_t
+  GetPartitionSize() const
+  {
+    return m_PartitionSize;
+  }
+
   /** Number of tangential relaxation sweeps per Remesh(). Default: 1. */
   void
   SetRelaxationSweeps(unsigned int sweeps)
@@ -317,14 +341,15 @@ private:
   Split(IndexType c);
   void
   CollapsePass();
+  struct SweepWorker;
   bool
-  TryCollapse(IndexType c, bool fromTwin = false);
+  TryCollapse(SweepWorker & worker, IndexType c, bool fromTwin = false);
   void
   FlipPass();
   /** Flips the edge of corner c when that improves the valences or, with
    * \a lengthen, when the new edge is longer and at most the maximum. */
   bool
-  TryFlip(IndexType c, bool lengthen = false);
+  TryFlip(SweepWorker & worker, IndexType c, bool lengthen = false);
   /** The cheap part of TryFlip(c): an interior edge listed from c whose
    * flip would bring the valences closer to 6 (4 on a boundary). */
   bool
@@ -363,21 +388,89 @@ private:
     Lengths,
     Valences
   };
-  /** Calls body(c) for each corner c, in increasing order, for which
-   * candidate(c) holds, as a serial loop over every corner calling body(c)
+  /** The state of a running sweep over a queue of corners (a bit per
+   * corner): the whole mesh's, or one part's (RunQueue()). A part reads and
+   * changes only its points [first, last) and the triangles all of whose
+   * points are among them; the other parts run at the same time. An
+   * operation that would reach another point (Reach()) is deferred, before
+   * it changes anything, to the serial sweep after the parts. */
+  struct SweepWorker
+  {
+    const uint8_t *          partOf{ nullptr }; // the part of each point
+    std::size_t              numberOfPoints{ 0 };
+    uint8_t                  part{ 0 };
+    bool                     partitioned{ false };
+    bool                     deferThis{ false }; // the running operation reached out of the part
+    SweepInputs              inputs{ SweepInputs::None };
+    IndexType                position{ 0 };
+    std::vector<uint64_t> *  queue{ nullptr };
+    bool                     trackStillShort{ false };
+    std::vector<IndexType> * stillShort{ nullptr };
+    std::vector<uint64_t>    ownQueue;
+    std::vector<IndexType>   ownStillShort;
+    std::vector<IndexType>   deferred;
+    std::vector<IndexType>   ringA;
+    std::vector<IndexType>   ringB;
+    std::vector<IndexType>   cornersA;
+    std::vector<IndexType>   cornersB;
+    std::size_t              collapses{ 0 };
+    std::size_t              flips{ 0 };
+    /** Whether the sweep may read and change point v; when not, marks the
+     * running operation for deferral. */
+    bool
+    Reach(IndexType v)
+    {
+      if (!partitioned || (v < numberOfPoints && partOf[v] == part))
+      {
+        return true;
+      }
+      deferThis = true;
+      return false;
+    }
+  };
+  /** Walks the ring of \a v into \a ring and reaches each of its points;
+   * false when the ring cannot be walked (frozen) or reaches out. */
+  bool
+  ReachRing(SweepWorker & worker, IndexType v, std::vector<IndexType> & ring, std::vector<IndexType> * corners) const
+  {
+    if (!this->Ring(v, ring, corners))
+    {
+      return false;
+    }
+    for (const IndexType w : ring)
+    {
+      if (!worker.Reach(w))
+      {
+        return false;
+      }
+    }
+    return true;
+  }
+  /** Calls body(worker, c) for each corner c, in increasing order, for which
+   * candidate(c) holds, as a serial loop over every corner calling body()
    * would: candidate(c) is a necessary condition of body(c) doing anything,
    * tested in parallel on the mesh as it is before the sweep; the
    * operations body() makes queue again the corners whose test they may
    * have changed (Requeue()), so that the result is the same, bit for bit,
-   * as that of the serial loop. */
+   * as that of the serial loop (for a mesh in parts: RunQueue()). */
   template <typename TCandidate, typename TBody>
   void
   Sweep(SweepInputs inputs, TCandidate && candidate, TBody && body);
-  /** Runs body(c) for the corners queued in m_Queue, in increasing order
-   * (the second half of Sweep()). */
+  /** Runs body(worker, c) for the corners queued in m_Queue (the second
+   * half of Sweep()): in increasing order on the whole mesh; or, for a mesh
+   * in parts (SetPartitionSize()), each part's corners (those of its
+   * points) in increasing order, the parts in parallel, then the deferred
+   * corners in increasing order on the whole mesh. */
   template <typename TBody>
   void
   RunQueue(SweepInputs inputs, TBody && body);
+  /** Runs \a worker's queue in increasing order. */
+  template <typename TBody>
+  void
+  RunWorker(SweepWorker & worker, TBody & body);
+  /** The number of parts of the passes on the current mesh (1: serial). */
+  std::size_t
+  NumberOfParts() const;
   /** Whether the edge of corner c is short, listed from c: an interior
    * edge seen from the lower of its two corners. */
   bool
@@ -385,26 +478,41 @@ private:
   {
     return m_V[c] != Invalid && m_O[c] >= static_cast<int64_t>(c) && this->Length2(m_V[c], m_V[Next(c)]) < m_Min2;
   }
-  /** Queues corner \a k and its twin for the running sweep, when ahead of it. */
+  /** Queues corner \a k and its twin for the running sweep, when ahead of
+   * it; in a part, a corner of another part's point goes to the deferred
+   * corners. */
   void
-  Requeue(int64_t k)
+  Requeue(SweepWorker & worker, int64_t k)
   {
     for (const int64_t corner : { k, k >= 0 ? m_O[static_cast<std::size_t>(k)] : k })
     {
-      if (corner > static_cast<int64_t>(m_SweepPosition))
+      if (corner < 0)
       {
-        m_Queue[static_cast<std::size_t>(corner) >> 6] |= uint64_t{ 1 } << (corner & 63);
+        continue;
       }
-      else if (m_TrackStillShort && corner >= 0)
+      if (worker.partitioned)
       {
-        m_StillShort.push_back(static_cast<IndexType>(corner));
+        const IndexType v = m_V[static_cast<std::size_t>(corner)];
+        if (v >= worker.numberOfPoints || worker.partOf[v] != worker.part)
+        {
+          worker.deferred.push_back(static_cast<IndexType>(corner));
+          continue;
+        }
+      }
+      if (corner > static_cast<int64_t>(worker.position))
+      {
+        (*worker.queue)[static_cast<std::size_t>(corner) >> 6] |= uint64_t{ 1 } << (corner & 63);
+      }
+      else if (worker.trackStillShort)
+      {
+        worker.stillShort->push_back(static_cast<IndexType>(corner));
       }
     }
   }
   /** Queues the three corners (and their twins) of each triangle of the
    * fan of \a v. */
   void
-  RequeueFan(IndexType v);
+  RequeueFan(SweepWorker & worker, IndexType v);
   void
   Compact(std::vector<double> & coordinates, std::vector<IndexType> & triangles);
 
@@ -447,10 +555,13 @@ private:
   Statistics             m_Statistics;
   double                 m_Min2{ 0.0 };
   double                 m_Max2{ 0.0 };
-  // The running Sweep(): its inputs, position and queue (a bit per corner).
-  SweepInputs           m_SweepInputs{ SweepInputs::None };
-  IndexType             m_SweepPosition{ 0 };
-  std::vector<uint64_t> m_Queue;
+  // The queue of the next RunQueue() (a bit per corner), its workers: the
+  // whole mesh's, and the parts'.
+  std::vector<uint64_t>    m_Queue;
+  std::size_t              m_PartitionSize{ 8192 };
+  SweepWorker              m_SerialWorker;
+  std::vector<SweepWorker> m_Workers;
+  std::vector<uint8_t>     m_PartOf;
   // Scratch, kept between calls so that large arrays are not allocated (and
   // their pages faulted in) at every remeshing.
   std::vector<std::pair<double, IndexType>> m_SplitCandidates;
@@ -461,10 +572,6 @@ private:
   std::vector<uint8_t>                      m_ScratchState;
   std::vector<int32_t>                      m_ScratchValence;
   std::vector<Link>                         m_ScratchO;
-  std::vector<IndexType>                    m_RingA;
-  std::vector<IndexType>                    m_RingB;
-  std::vector<IndexType>                    m_CornersA;
-  std::vector<IndexType>                    m_CornersB;
 };
 
 enum : uint8_t
@@ -575,37 +682,140 @@ DeformableMeshRemesher::Sweep(SweepInputs inputs, TCandidate && candidate, TBody
 
 template <typename TBody>
 void
-DeformableMeshRemesher::RunQueue(SweepInputs inputs, TBody && body)
+DeformableMeshRemesher::RunWorker(SweepWorker & worker, TBody & body)
 {
-  const std::size_t words = m_Queue.size();
-  m_SweepInputs = inputs;
+  std::vector<uint64_t> & queue = *worker.queue;
+  const std::size_t       words = queue.size();
   for (std::size_t w = 0; w < words; ++w)
   {
     // Read again after each corner: its operation may queue later corners
     // of the same word.
-    for (uint64_t bits = m_Queue[w]; bits != 0; bits = m_Queue[w])
+    for (uint64_t bits = queue[w]; bits != 0; bits = queue[w])
     {
       const unsigned int j = LowestBit(bits);
-      m_Queue[w] = bits & (bits - 1);
-      m_SweepPosition = static_cast<IndexType>(64 * w + j);
-      body(m_SweepPosition);
+      queue[w] = bits & (bits - 1);
+      worker.position = static_cast<IndexType>(64 * w + j);
+      worker.deferThis = false;
+      body(worker, worker.position);
+      if (worker.deferThis)
+      {
+        worker.deferred.push_back(worker.position);
+      }
     }
   }
-  m_SweepInputs = SweepInputs::None;
+}
+
+inline std::size_t
+DeformableMeshRemesher::NumberOfParts() const
+{
+  const std::size_t numberOfPoints = m_State.size();
+  if (m_PartitionSize == 0 || numberOfPoints < 2 * m_PartitionSize)
+  {
+    return 1;
+  }
+  const std::size_t most = numberOfPoints / m_PartitionSize;
+  return most >= 8 ? 8 : (most >= 4 ? 4 : 2);
+}
+
+template <typename TBody>
+void
+DeformableMeshRemesher::RunQueue(SweepInputs inputs, TBody && body)
+{
+  const std::size_t parts = this->NumberOfParts();
+  SweepWorker &     serial = m_SerialWorker;
+  serial.partitioned = false;
+  serial.inputs = inputs;
+  serial.queue = &m_Queue;
+  serial.trackStillShort = m_TrackStillShort;
+  serial.stillShort = &m_StillShort;
+  serial.deferred.clear();
+  serial.collapses = 0;
+  serial.flips = 0;
+  if (parts > 1)
+  {
+    // The parts: ranges of the input's point numbers, each point split from
+    // an edge in the part of the point it comes from (Parents(); the new
+    // points are numbered after the input's, far from their neighbours).
+    const std::size_t numberOfPoints = m_State.size();
+    const std::size_t words = m_Queue.size();
+    m_PartOf.resize(numberOfPoints);
+    for (std::size_t v = 0; v < numberOfPoints; ++v)
+    {
+      m_PartOf[v] = v < m_InputPoints ? static_cast<uint8_t>(v * parts / m_InputPoints) : m_PartOf[m_Parents[v]];
+    }
+    m_Workers.resize(parts);
+    for (std::size_t p = 0; p < parts; ++p)
+    {
+      SweepWorker & worker = m_Workers[p];
+      worker.partOf = m_PartOf.data();
+      worker.numberOfPoints = numberOfPoints;
+      worker.part = static_cast<uint8_t>(p);
+      worker.partitioned = true;
+      worker.inputs = inputs;
+      worker.ownQueue.assign(words, 0);
+      worker.queue = &worker.ownQueue;
+      worker.trackStillShort = m_TrackStillShort;
+      worker.ownStillShort.clear();
+      worker.stillShort = &worker.ownStillShort;
+      worker.deferred.clear();
+      worker.collapses = 0;
+      worker.flips = 0;
+    }
+    for (std::size_t w = 0; w < words; ++w)
+    {
+      for (uint64_t bits = m_Queue[w]; bits != 0; bits &= bits - 1)
+      {
+        const std::size_t c = 64 * w + LowestBit(bits);
+        const IndexType   v = m_V[c];
+        if (v != Invalid)
+        {
+          m_Workers[m_PartOf[v]].ownQueue[w] |= uint64_t{ 1 } << (c & 63);
+        }
+      }
+    }
+    // The parts in parallel; then what they deferred, in order.
+    const auto runPart = [this, &body](SizeValueType p) { this->RunWorker(m_Workers[p], body); };
+    if (m_Threader != nullptr)
+    {
+      m_Threader->SetNumberOfWorkUnits(std::max(1u, m_WorkUnits));
+      m_Threader->ParallelizeArray(0, parts, runPart, nullptr);
+    }
+    else
+    {
+      for (std::size_t p = 0; p < parts; ++p)
+      {
+        runPart(p);
+      }
+    }
+    std::fill(m_Queue.begin(), m_Queue.end(), 0);
+    for (SweepWorker & worker : m_Workers)
+    {
+      for (const IndexType c : worker.deferred)
+      {
+        m_Queue[c >> 6] |= uint64_t{ 1 } << (c & 63);
+      }
+      m_StillShort.insert(m_StillShort.end(), worker.ownStillShort.begin(), worker.ownStillShort.end());
+      m_Statistics.collapses += worker.collapses;
+      m_Statistics.flips += worker.flips;
+    }
+  }
+  this->RunWorker(serial, body);
+  m_Statistics.collapses += serial.collapses;
+  m_Statistics.flips += serial.flips;
 }
 
 inline void
-DeformableMeshRemesher::RequeueFan(IndexType v)
+DeformableMeshRemesher::RequeueFan(SweepWorker & worker, IndexType v)
 {
-  if (!this->Ring(v, m_RingA, &m_CornersA))
+  if (!this->Ring(v, worker.ringA, &worker.cornersA))
   {
     return;
   }
-  for (const IndexType k : m_CornersA)
+  for (const IndexType k : worker.cornersA)
   {
-    this->Requeue(k);
-    this->Requeue(Next(k));
-    this->Requeue(Prev(k));
+    this->Requeue(worker, k);
+    this->Requeue(worker, Next(k));
+    this->Requeue(worker, Prev(k));
   }
 }
 
@@ -1018,7 +1228,7 @@ DeformableMeshRemesher::SplitPass(bool all)
 }
 
 inline bool
-DeformableMeshRemesher::TryCollapse(IndexType c, bool fromTwin)
+DeformableMeshRemesher::TryCollapse(SweepWorker & worker, IndexType c, bool fromTwin)
 {
   const Link o = m_O[c];
   if (o < 0)
@@ -1027,11 +1237,15 @@ DeformableMeshRemesher::TryCollapse(IndexType c, bool fromTwin)
   }
   const IndexType a = m_V[c];
   const IndexType b = m_V[Next(c)];
+  if (!worker.Reach(a) || !worker.Reach(b))
+  {
+    return false;
+  }
   if (m_State[b] != RemesherFree)
   {
     // Into a boundary end-point, which stays where it is: from its side.
     return m_State[a] == RemesherFree && m_State[b] == RemesherBoundary && !fromTwin &&
-           this->TryCollapse(static_cast<IndexType>(o), true);
+           this->TryCollapse(worker, static_cast<IndexType>(o), true);
   }
   if (m_State[a] != RemesherFree && m_State[a] != RemesherBoundary)
   {
@@ -1040,23 +1254,29 @@ DeformableMeshRemesher::TryCollapse(IndexType c, bool fromTwin)
   const bool      keepA = m_State[a] == RemesherBoundary;
   const IndexType C = m_V[Prev(c)];
   const IndexType D = m_V[Prev(static_cast<IndexType>(o))];
-  if (C == D || m_Valence[C] <= 3 || m_Valence[D] <= 3)
+  if (!worker.Reach(C) || !worker.Reach(D) || C == D || m_Valence[C] <= 3 || m_Valence[D] <= 3)
   {
     return false;
   }
-  if (!this->Ring(a, m_RingA, &m_CornersA) || !this->Ring(b, m_RingB, &m_CornersB))
+  std::vector<IndexType> & ringA = worker.ringA;
+  std::vector<IndexType> & ringB = worker.ringB;
+  std::vector<IndexType> & cornersA = worker.cornersA;
+  std::vector<IndexType> & cornersB = worker.cornersB;
+  // Both fans and every point of them in reach: the operation reads and
+  // changes nothing else.
+  if (!this->ReachRing(worker, a, ringA, &cornersA) || !this->ReachRing(worker, b, ringB, &cornersB))
   {
     return false;
   }
   // Link condition: the common neighbours of a and b are C and D only.
-  for (const IndexType w : m_RingA)
+  for (const IndexType w : ringA)
   {
-    if (w != C && w != D && w != b && std::find(m_RingB.begin(), m_RingB.end(), w) != m_RingB.end())
+    if (w != C && w != D && w != b && std::find(ringB.begin(), ringB.end(), w) != ringB.end())
     {
       return false;
     }
   }
-  if (m_RingA.size() + m_RingB.size() < 8)
+  if (ringA.size() + ringB.size() < 8)
   {
     return false; // the result would have a vertex of valence below 3
   }
@@ -1067,7 +1287,7 @@ DeformableMeshRemesher::TryCollapse(IndexType c, bool fromTwin)
   // The merged vertex goes to the midpoint, or else to either end-point.
   const auto acceptable = [&](const double * p) {
     // No edge longer than the maximum.
-    for (const std::vector<IndexType> * ring : { &m_RingA, &m_RingB })
+    for (const std::vector<IndexType> * ring : { &ringA, &ringB })
     {
       for (const IndexType w : *ring)
       {
@@ -1088,7 +1308,7 @@ DeformableMeshRemesher::TryCollapse(IndexType c, bool fromTwin)
     // No triangle turned around: each triangle of a or b other than the two
     // removed stays within 60 degrees of its former direction, and is not
     // degenerate.
-    for (const std::vector<IndexType> * corners : { &m_CornersA, &m_CornersB })
+    for (const std::vector<IndexType> * corners : { &cornersA, &cornersB })
     {
       for (const IndexType k : *corners)
       {
@@ -1141,7 +1361,7 @@ DeformableMeshRemesher::TryCollapse(IndexType c, bool fromTwin)
 
   // Collapse: b's corners become a's, the two triangles go, their outer
   // half-edges are glued.
-  for (const IndexType k : m_CornersB)
+  for (const IndexType k : cornersB)
   {
     m_V[k] = a;
   }
@@ -1180,18 +1400,18 @@ DeformableMeshRemesher::TryCollapse(IndexType c, bool fromTwin)
   --m_Valence[D];
   m_State[b] = RemesherRemoved;
   std::copy(mid, mid + 3, m_X.data() + 3 * static_cast<std::size_t>(a));
-  ++m_Statistics.collapses;
-  if (m_SweepInputs != SweepInputs::None)
+  ++worker.collapses;
+  if (worker.inputs != SweepInputs::None)
   {
     // Every edge of a changed (its end-point, twin or length).
-    for (const std::vector<IndexType> * corners : { &m_CornersA, &m_CornersB })
+    for (const std::vector<IndexType> * corners : { &cornersA, &cornersB })
     {
       for (const IndexType k : *corners)
       {
         if (k / 3 != tc && k / 3 != to)
         {
-          this->Requeue(k);
-          this->Requeue(Prev(k));
+          this->Requeue(worker, k);
+          this->Requeue(worker, Prev(k));
         }
       }
     }
@@ -1205,16 +1425,20 @@ DeformableMeshRemesher::CollapsePass()
   // The short edges: those of the mesh before the pass, and those that the
   // collapses and flips of the pass change (queued again).
   const auto shortEdge = [this](IndexType c) { return this->ShortEdge(c); };
-  const auto body = [&](IndexType c) {
+  const auto body = [&](SweepWorker & worker, IndexType c) {
     // A short edge that cannot be collapsed is flipped to the longer
     // diagonal when that one is within the band.
-    if (shortEdge(c) && !this->TryCollapse(c))
+    if (m_V[c] == Invalid || !worker.Reach(m_V[c]) || !worker.Reach(m_V[Next(c)]))
     {
-      this->TryFlip(c, true);
+      return;
     }
-    if (shortEdge(c))
+    if (shortEdge(c) && !this->TryCollapse(worker, c) && !worker.deferThis)
     {
-      m_StillShort.push_back(c);
+      this->TryFlip(worker, c, true);
+    }
+    if (!worker.deferThis && shortEdge(c))
+    {
+      worker.stillShort->push_back(c);
     }
   };
   m_StillShort.clear();
@@ -1272,7 +1496,7 @@ DeformableMeshRemesher::FlipImprovesValences(IndexType c) const
 }
 
 inline bool
-DeformableMeshRemesher::TryFlip(IndexType c, bool lengthen)
+DeformableMeshRemesher::TryFlip(SweepWorker & worker, IndexType c, bool lengthen)
 {
   const Link o = m_O[c];
   if (o < 0)
@@ -1288,7 +1512,7 @@ DeformableMeshRemesher::TryFlip(IndexType c, bool lengthen)
   const IndexType b = m_V[nc];
   const IndexType C = m_V[pc];
   const IndexType D = m_V[po];
-  if (C == D)
+  if (!worker.Reach(a) || !worker.Reach(b) || !worker.Reach(C) || !worker.Reach(D) || C == D)
   {
     return false;
   }
@@ -1322,7 +1546,8 @@ DeformableMeshRemesher::TryFlip(IndexType c, bool lengthen)
     return false;
   }
   // The new edge C - D must not exist.
-  if (!this->Ring(C, m_RingA, nullptr) || std::find(m_RingA.begin(), m_RingA.end(), D) != m_RingA.end())
+  std::vector<IndexType> & ring = worker.ringA;
+  if (!this->Ring(C, ring, nullptr) || std::find(ring.begin(), ring.end(), D) != ring.end())
   {
     return false;
   }
@@ -1353,6 +1578,34 @@ DeformableMeshRemesher::TryFlip(IndexType c, bool lengthen)
   // t = (a, D, C), u = (b, C, D).
   const Link a1 = m_O[no]; // twin of a -> D
   const Link b1 = m_O[nc]; // twin of b -> C
+  if (worker.partitioned)
+  {
+    // The triangles across a - D and b - C get new twins: their third
+    // points in reach; with the valences as inputs, the fans of the four
+    // points, whose edges are queued again.
+    if ((a1 >= 0 && !worker.Reach(m_V[Prev(static_cast<IndexType>(a1))])) ||
+        (b1 >= 0 && !worker.Reach(m_V[Prev(static_cast<IndexType>(b1))])))
+    {
+      return false;
+    }
+    if (worker.inputs == SweepInputs::Valences)
+    {
+      for (const IndexType v : { a, b, C, D })
+      {
+        if (!this->Ring(v, worker.ringB, nullptr))
+        {
+          return false;
+        }
+        for (const IndexType w : worker.ringB)
+        {
+          if (!worker.Reach(w))
+          {
+            return false;
+          }
+        }
+      }
+    }
+  }
   m_V[nc] = D;
   m_V[no] = C;
   m_O[c] = a1;
@@ -1375,21 +1628,21 @@ DeformableMeshRemesher::TryFlip(IndexType c, bool lengthen)
   --m_Valence[b];
   ++m_Valence[C];
   ++m_Valence[D];
-  ++m_Statistics.flips;
-  if (m_SweepInputs == SweepInputs::Valences)
+  ++worker.flips;
+  if (worker.inputs == SweepInputs::Valences)
   {
     // The valence test of every edge with one of the four as an end-point
     // or an opposite vertex.
     for (const IndexType v : { a, b, C, D })
     {
-      this->RequeueFan(v);
+      this->RequeueFan(worker, v);
     }
   }
-  else if (m_SweepInputs == SweepInputs::Lengths)
+  else if (worker.inputs == SweepInputs::Lengths)
   {
     for (const IndexType k : { c, nc, pc, oc, no, po })
     {
-      this->Requeue(k);
+      this->Requeue(worker, k);
     }
   }
   return true;
@@ -1402,10 +1655,10 @@ DeformableMeshRemesher::FlipPass()
   this->Sweep(
     SweepInputs::Valences,
     [this](IndexType c) { return m_V[c] != Invalid && this->FlipImprovesValences(c); },
-    [this](IndexType c) {
+    [this](SweepWorker & worker, IndexType c) {
       if (m_V[c] != Invalid && m_O[c] >= static_cast<int64_t>(c))
       {
-        this->TryFlip(c);
+        this->TryFlip(worker, c);
       }
     });
 }
@@ -1571,8 +1824,8 @@ DeformableMeshRemesher::LengthenPass()
     const double length2 = this->Length2(m_V[c], m_V[Next(c)]);
     return length2 < m_Min2 && length2 > 0.0;
   };
-  const auto body = [&](IndexType c) {
-    if (!shortEdge(c))
+  const auto body = [&](SweepWorker & worker, IndexType c) {
+    if (m_V[c] == Invalid || !worker.Reach(m_V[c]) || !worker.Reach(m_V[Next(c)]) || !shortEdge(c))
     {
       return;
     }
@@ -1586,15 +1839,31 @@ DeformableMeshRemesher::LengthenPass()
     const double    missing = 1.01 * minimum - length;
     // Both end-points half the way, or one of them all the way. The rings of
     // a and b are walked once, when first needed (nothing moves before the
-    // move made).
-    int        walked[2] = { -1, -1 };
-    const auto movable = [&](unsigned int which) {
+    // move made); in a part, both at once, and every point of them in reach.
+    std::vector<IndexType> & ringA = worker.ringA;
+    std::vector<IndexType> & ringB = worker.ringB;
+    std::vector<IndexType> & cornersA = worker.cornersA;
+    std::vector<IndexType> & cornersB = worker.cornersB;
+    int                      walked[2] = { -1, -1 };
+    const auto               walk = [&](unsigned int which) {
       if (walked[which] < 0)
       {
         const IndexType v = which == 0 ? a : b;
         walked[which] = m_State[v] == RemesherFree &&
-                        this->Ring(v, which == 0 ? m_RingA : m_RingB, which == 0 ? &m_CornersA : &m_CornersB);
+                        this->ReachRing(worker, v, which == 0 ? ringA : ringB, which == 0 ? &cornersA : &cornersB);
       }
+    };
+    if (worker.partitioned)
+    {
+      walk(0);
+      walk(1);
+      if (worker.deferThis)
+      {
+        return;
+      }
+    }
+    const auto movable = [&](unsigned int which) {
+      walk(which);
       return walked[which] == 1;
     };
     // First within the band; failing that, a move that leaves every other
@@ -1612,8 +1881,8 @@ DeformableMeshRemesher::LengthenPass()
           qa[d] = pa[d] - share[0] * missing * u[d];
           qb[d] = pb[d] + share[1] * missing * u[d];
         }
-        if ((share[0] == 0.0 || (movable(0) && this->MoveKeepsBand(a, qa, b, m_RingA, m_CornersA, floor2))) &&
-            (share[1] == 0.0 || (movable(1) && this->MoveKeepsBand(b, qb, a, m_RingB, m_CornersB, floor2))))
+        if ((share[0] == 0.0 || (movable(0) && this->MoveKeepsBand(a, qa, b, ringA, cornersA, floor2))) &&
+            (share[1] == 0.0 || (movable(1) && this->MoveKeepsBand(b, qb, a, ringB, cornersB, floor2))))
         {
           std::copy(qa, qa + 3, pa);
           std::copy(qb, qb + 3, pb);

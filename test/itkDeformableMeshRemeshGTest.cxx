@@ -26,6 +26,7 @@
 #include "itkEllipsoidPhantom.h"
 #include "itkExternalForceImageFilter.h"
 #include "itkMesh.h"
+#include "itkMultiThreaderBase.h"
 #include "edmTestUtilities.h"
 #include "gtest/gtest.h"
 
@@ -425,6 +426,86 @@ TEST(DeformableMeshRemesher, KeptTableGivesTheSameMeshAsAFreshOne)
   EXPECT_EQ(kept.Points(), before.Points());
   EXPECT_NE(kept.x, before.x) << "the relaxation moved points";
   EXPECT_GT(statistics.relaxed, 0u);
+}
+
+TEST(DeformableMeshRemesher, PartsGiveOneMeshWhateverTheThreadsAndAValidOne)
+{
+  // A sphere of 10 242 points numbered for locality, stretched along z
+  // between rounds so that every round splits, collapses and flips:
+  // remeshed in 8 parts (PartitionSize 1024) on 2 threads, in the same parts
+  // without a threader, and in one serial sweep (PartitionSize 0).
+  PointType centre;
+  centre.Fill(0.0);
+  const FlatMesh         input = ToFlat(itk::MakeSphereMesh<MeshType>(centre, 10.0, 5));
+  const auto             order = itk::DeformableMeshRemesher::LocalityOrder(input.x.data(), input.Points());
+  std::vector<IndexType> rank(order.size());
+  FlatMesh               numbered;
+  for (std::size_t k = 0; k < order.size(); ++k)
+  {
+    rank[order[k]] = static_cast<IndexType>(k);
+    numbered.x.insert(numbered.x.end(), input.x.begin() + 3 * order[k], input.x.begin() + 3 * order[k] + 3);
+  }
+  for (const IndexType v : input.triangles)
+  {
+    numbered.triangles.push_back(rank[v]);
+  }
+  auto threader = itk::MultiThreaderBase::New();
+  threader->SetMaximumNumberOfThreads(2);
+  itk::DeformableMeshRemesher threaded;
+  itk::DeformableMeshRemesher unthreaded;
+  itk::DeformableMeshRemesher serial;
+  threaded.SetMultiThreader(threader, 8);
+  for (itk::DeformableMeshRemesher * remesher : { &threaded, &unthreaded, &serial })
+  {
+    remesher->SetTargetEdgeLength(0.4);
+    remesher->SetPartitionSize(remesher == &serial ? 0 : 1024);
+  }
+  EXPECT_EQ(serial.GetPartitionSize(), 0u);
+  FlatMesh    a = numbered;
+  FlatMesh    b = numbered;
+  FlatMesh    c = numbered;
+  bool        differs = false;
+  std::size_t operations = 0;
+  double      smallestInParts = 180.0;
+  double      smallestSerial = 180.0;
+  for (int round = 0; round < 6; ++round)
+  {
+    const auto statistics = threaded.Remesh(a.x, a.Points(), a.triangles);
+    unthreaded.Remesh(b.x, b.Points(), b.triangles);
+    serial.Remesh(c.x, c.Points(), c.triangles);
+    ASSERT_EQ(a.triangles, b.triangles) << "round " << round;
+    ASSERT_EQ(a.x, b.x) << "round " << round;
+    ASSERT_EQ(threaded.Parents(), unthreaded.Parents()) << "round " << round;
+    differs = differs || a.triangles != c.triangles || a.x != c.x;
+    operations += statistics.collapses + statistics.flips;
+    EXPECT_TRUE(threaded.IsOutputClosed()) << "round " << round;
+    EXPECT_TRUE(CollisionSaysClosed(a)) << "round " << round;
+    const Topology t = Analyse(a);
+    EXPECT_EQ(t.badEdges, 0u) << "round " << round;
+    EXPECT_EQ(t.boundaryEdges, 0u) << "round " << round;
+    EXPECT_EQ(t.degenerate, 0u) << "round " << round;
+    EXPECT_EQ(t.Euler(), 2) << "round " << round;
+    EXPECT_EQ(t.vertices, a.Points()) << "no unused point, round " << round;
+    double shortest = 0.0;
+    double longest = 0.0;
+    EdgeLengthRange(a, shortest, longest);
+    EXPECT_LE(longest, threaded.GetMaximumEdgeLength()) << "round " << round;
+    smallestInParts = std::min(smallestInParts, SmallestAngle(a));
+    smallestSerial = std::min(smallestSerial, SmallestAngle(c));
+    for (FlatMesh * m : { &a, &b, &c })
+    {
+      for (std::size_t i = 0; i < m->Points(); ++i)
+      {
+        m->x[3 * i + 2] *= 1.04;
+      }
+    }
+  }
+  EXPECT_TRUE(differs) << "the parts change the order of the operations";
+  EXPECT_GT(operations, 5000u);
+  EXPECT_GE(smallestInParts, smallestSerial - 2.0);
+  std::cout << "in parts: " << a.Points() << " points, " << operations << " collapses and flips, smallest angle "
+            << smallestInParts << " (serial: " << c.Points() << " points, smallest angle " << smallestSerial << ")"
+            << std::endl;
 }
 
 TEST(DeformableMeshRemesher, LockedVerticesAndTheirTrianglesComeOutAsTheyWentIn)
