@@ -561,7 +561,8 @@ private:
   std::size_t              m_PartitionSize{ 8192 };
   SweepWorker              m_SerialWorker;
   std::vector<SweepWorker> m_Workers;
-  std::vector<uint8_t>     m_PartOf;
+  std::vector<uint8_t>     m_PartOf;           // the part of each point (RunQueue())
+  std::size_t              m_PartOfParts{ 0 }; // for this many parts; 0: to be made
   // Scratch, kept between calls so that large arrays are not allocated (and
   // their pages faulted in) at every remeshing.
   std::vector<std::pair<double, IndexType>> m_SplitCandidates;
@@ -738,8 +739,12 @@ DeformableMeshRemesher::RunQueue(SweepInputs inputs, TBody && body)
     // points are numbered after the input's, far from their neighbours).
     const std::size_t numberOfPoints = m_State.size();
     const std::size_t words = m_Queue.size();
+    // Kept from the last sweep of this Remesh() when the parts are the same:
+    // the points added since (splits) come after, their parents before.
+    const std::size_t known = m_PartOfParts == parts ? std::min(m_PartOf.size(), numberOfPoints) : 0;
     m_PartOf.resize(numberOfPoints);
-    for (std::size_t v = 0; v < numberOfPoints; ++v)
+    m_PartOfParts = parts;
+    for (std::size_t v = known; v < numberOfPoints; ++v)
     {
       m_PartOf[v] = v < m_InputPoints ? static_cast<uint8_t>(v * parts / m_InputPoints) : m_PartOf[m_Parents[v]];
     }
@@ -752,7 +757,7 @@ DeformableMeshRemesher::RunQueue(SweepInputs inputs, TBody && body)
       worker.part = static_cast<uint8_t>(p);
       worker.partitioned = true;
       worker.inputs = inputs;
-      worker.ownQueue.assign(words, 0);
+      worker.ownQueue.resize(words); // all 0: each run empties its queue
       worker.queue = &worker.ownQueue;
       worker.trackStillShort = m_TrackStillShort;
       worker.ownStillShort.clear();
@@ -763,7 +768,9 @@ DeformableMeshRemesher::RunQueue(SweepInputs inputs, TBody && body)
     }
     for (std::size_t w = 0; w < words; ++w)
     {
-      for (uint64_t bits = m_Queue[w]; bits != 0; bits &= bits - 1)
+      const uint64_t queued = m_Queue[w];
+      m_Queue[w] = 0;
+      for (uint64_t bits = queued; bits != 0; bits &= bits - 1)
       {
         const std::size_t c = 64 * w + LowestBit(bits);
         const IndexType   v = m_V[c];
@@ -787,7 +794,6 @@ DeformableMeshRemesher::RunQueue(SweepInputs inputs, TBody && body)
         runPart(p);
       }
     }
-    std::fill(m_Queue.begin(), m_Queue.end(), 0);
     for (SweepWorker & worker : m_Workers)
     {
       for (const IndexType c : worker.deferred)
@@ -2119,6 +2125,7 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
   m_ShortEdgesValid = false;
   m_StillShortValid = false;
   m_InputPoints = numberOfPoints;
+  m_PartOfParts = 0;
   m_Min2 = GetMinimumEdgeLength() * GetMinimumEdgeLength();
   m_Max2 = GetMaximumEdgeLength() * GetMaximumEdgeLength();
   m_X.assign(coordinates.begin(), coordinates.begin() + 3 * numberOfPoints);
