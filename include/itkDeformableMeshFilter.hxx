@@ -1726,6 +1726,7 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
 
   std::vector<uint8_t> locked(numberOfPoints, 0);
   std::vector<uint8_t> changed;
+  std::vector<uint8_t> pointMoved;
   std::vector<uint8_t> contacts;
   std::vector<uint8_t> seeds;
   for (;;)
@@ -1736,29 +1737,50 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
       const IndexType32 p = parents[v];
       return x[3 * v] != before[3 * p] || x[3 * v + 1] != before[3 * p + 1] || x[3 * v + 2] != before[3 * p + 2];
     };
-    // In parallel, whether a point moved (2: none did, the input's
-    // triangles decide, below and in order).
-    changed.assign(remeshedTriangles, 0);
+    // In parallel, whether each point moved, then whether a triangle's
+    // points did (2: none did, the input's triangles decide, below and in
+    // order, in the blocks that have such triangles).
+    const SizeValueType     remeshedPoints = parents.size();
     constexpr SizeValueType block = 16384;
     MultiThreaderBase *     threader = this->GetMultiThreader();
     threader->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
+    pointMoved.resize(remeshedPoints);
     threader->ParallelizeArray(
       0,
-      (remeshedTriangles + block - 1) / block,
+      (remeshedPoints + block - 1) / block,
       [&](SizeValueType b) {
-        for (SizeValueType t = b * block; t < std::min(remeshedTriangles, (b + 1) * block); ++t)
+        for (SizeValueType i = b * block; i < std::min(remeshedPoints, (b + 1) * block); ++i)
         {
-          const IndexType32 * v = m_Triangles.data() + 3 * t;
-          changed[t] = moved(v[0]) || moved(v[1]) || moved(v[2]) ? 1 : 2;
+          pointMoved[i] = moved(static_cast<IndexType32>(i)) ? 1 : 0;
         }
       },
       nullptr);
-    for (SizeValueType t = 0; t < remeshedTriangles; ++t)
+    const SizeValueType  triangleBlocks = (remeshedTriangles + block - 1) / block;
+    std::vector<uint8_t> blockUnmoved(triangleBlocks, 0);
+    changed.resize(remeshedTriangles);
+    threader->ParallelizeArray(
+      0,
+      triangleBlocks,
+      [&](SizeValueType b) {
+        uint8_t unmoved = 0;
+        for (SizeValueType t = b * block; t < std::min(remeshedTriangles, (b + 1) * block); ++t)
+        {
+          const IndexType32 * v = m_Triangles.data() + 3 * t;
+          changed[t] = (pointMoved[v[0]] | pointMoved[v[1]] | pointMoved[v[2]]) != 0 ? 1 : 2;
+          unmoved |= changed[t] == 2 ? 1 : 0;
+        }
+        blockUnmoved[b] = unmoved;
+      },
+      nullptr);
+    for (SizeValueType b = 0; b < triangleBlocks; ++b)
     {
-      if (changed[t] == 2)
+      for (SizeValueType t = b * block; blockUnmoved[b] != 0 && t < std::min(remeshedTriangles, (b + 1) * block); ++t)
       {
-        const IndexType32 * v = m_Triangles.data() + 3 * t;
-        changed[t] = isInputTriangle(sorted(parents[v[0]], parents[v[1]], parents[v[2]])) ? 0 : 1;
+        if (changed[t] == 2)
+        {
+          const IndexType32 * v = m_Triangles.data() + 3 * t;
+          changed[t] = isInputTriangle(sorted(parents[v[0]], parents[v[1]], parents[v[2]])) ? 0 : 1;
+        }
       }
     }
     // The collision test's surface and index for the remeshed mesh, built
