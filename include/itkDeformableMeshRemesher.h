@@ -78,7 +78,13 @@ namespace itk
  * the input vertex it comes from (the vertex itself, or the first end-point
  * of the edge it was split from), for carrying per-vertex state.
  *
- * Deterministic: the same input gives the same output, bit for bit.
+ * Deterministic: the same input gives the same output, bit for bit, whatever
+ * the threads. On a mesh of at least 2 PartitionSize points the collapse,
+ * flip and lengthening passes run in parts of consecutive point numbers
+ * (SetPartitionSize()): each part in corner order, in parallel with the
+ * others, then the operations that reach across parts in corner order; the
+ * output depends on the number of parts, which the mesh and PartitionSize
+ * set.
  *
  * \sa DeformableMeshFilter
  * \ingroup ExplicitDeformableModel
