@@ -1604,16 +1604,9 @@ DeformableMeshRemesher::TryFlip(SweepWorker & worker, IndexType c, bool lengthen
     {
       for (const IndexType v : { a, b, C, D })
       {
-        if (!this->Ring(v, worker.ringB, nullptr))
+        if (!this->ReachRing(worker, v, worker.ringB, nullptr))
         {
           return false;
-        }
-        for (const IndexType w : worker.ringB)
-        {
-          if (!worker.Reach(w))
-          {
-            return false;
-          }
         }
       }
     }
