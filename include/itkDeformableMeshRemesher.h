@@ -559,6 +559,7 @@ private:
   bool                   m_StillShortValid{ false };
   std::vector<IndexType> m_NewIndex; // scratch of Compact()
   std::vector<IndexType> m_NewCorner;
+  std::vector<IndexType> m_TriangleKey; // scratch of Compact()
   std::size_t            m_InputPoints{ 0 };
   Statistics             m_Statistics;
   double                 m_Min2{ 0.0 };
@@ -2022,10 +2023,19 @@ DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<I
     // split from its edges (a counting sort on the input ancestor).
     std::vector<IndexType> & root = m_Root;
     root.resize(numberOfPoints);
-    for (std::size_t i = 0; i < numberOfPoints; ++i)
-    {
-      root[i] = i < m_InputPoints ? static_cast<IndexType>(i) : root[m_Parents[i]];
-    }
+    this->ParallelFor(numberOfPoints, [&](std::size_t first, std::size_t last) {
+      for (std::size_t i = first; i < last; ++i)
+      {
+        // A split point's parent may be another split point: follow to the
+        // input.
+        IndexType r = static_cast<IndexType>(i);
+        while (r >= m_InputPoints)
+        {
+          r = m_Parents[r];
+        }
+        root[i] = r;
+      }
+    });
     std::vector<IndexType> & start = m_Start;
     start.assign(m_InputPoints + 1, 0);
     for (std::size_t i = 0; i < numberOfPoints; ++i)
@@ -2055,18 +2065,10 @@ DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<I
       {
         const IndexType k = start[root[i]]++;
         newIndex[i] = k;
-        parents[k] = i < m_InputPoints ? static_cast<IndexType>(i) : m_Parents[i];
+        parents[k] = root[i];
         state[k] = m_State[i];
         valence[k] = m_Valence[i];
         std::copy(m_X.data() + 3 * i, m_X.data() + 3 * i + 3, coordinates.data() + 3 * static_cast<std::size_t>(k));
-      }
-    }
-    // A split vertex's parent may be another split vertex: follow to the input.
-    for (IndexType & p : parents)
-    {
-      while (p >= m_InputPoints)
-      {
-        p = m_Parents[p];
       }
     }
     m_Parents.swap(parents);
@@ -2080,16 +2082,26 @@ DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<I
     // would lie far from their neighbours, in the order of their edge
     // lengths.
     std::vector<IndexType> & newCorner = m_NewCorner;
-    newCorner.assign(numberOfCorners, Invalid);
-    start.assign(static_cast<std::size_t>(kept) + 1, 0);
-    const auto smallest = [&](std::size_t c) {
-      return std::min({ newIndex[m_V[c]], newIndex[m_V[c + 1]], newIndex[m_V[c + 2]] });
-    };
-    for (std::size_t c = 0; c < numberOfCorners; c += 3)
-    {
-      if (m_V[c] != Invalid)
+    newCorner.resize(numberOfCorners);
+    // The keys in parallel (three reads of the new numbers each); the
+    // counting sort itself reads them in order.
+    const std::size_t        numberOfTriangles = numberOfCorners / 3;
+    std::vector<IndexType> & key = m_TriangleKey;
+    key.resize(numberOfTriangles);
+    this->ParallelFor(numberOfTriangles, [&](std::size_t first, std::size_t last) {
+      for (std::size_t t = first; t < last; ++t)
       {
-        ++start[smallest(c) + 1];
+        const std::size_t c = 3 * t;
+        key[t] =
+          m_V[c] == Invalid ? Invalid : std::min({ newIndex[m_V[c]], newIndex[m_V[c + 1]], newIndex[m_V[c + 2]] });
+      }
+    });
+    start.assign(static_cast<std::size_t>(kept) + 1, 0);
+    for (const IndexType k : key)
+    {
+      if (k != Invalid)
+      {
+        ++start[k + 1];
       }
     }
     for (std::size_t i = 0; i < kept; ++i)
@@ -2097,15 +2109,13 @@ DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<I
       start[i + 1] += start[i];
     }
     const IndexType next = 3 * start[kept];
-    for (std::size_t c = 0; c < numberOfCorners; c += 3)
+    for (std::size_t t = 0; t < numberOfTriangles; ++t)
     {
-      if (m_V[c] != Invalid)
-      {
-        const IndexType t = 3 * start[smallest(c)]++;
-        newCorner[c] = t;
-        newCorner[c + 1] = t + 1;
-        newCorner[c + 2] = t + 2;
-      }
+      const IndexType k = key[t];
+      const IndexType nt = k != Invalid ? 3 * start[k]++ : Invalid;
+      newCorner[3 * t] = nt;
+      newCorner[3 * t + 1] = k != Invalid ? nt + 1 : Invalid;
+      newCorner[3 * t + 2] = k != Invalid ? nt + 2 : Invalid;
     }
     triangles.resize(next);
     std::vector<Link> & opposite = m_ScratchO;
