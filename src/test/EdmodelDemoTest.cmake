@@ -70,8 +70,8 @@ endif()
 
 # With a display: Figure 1.
 if(FIGURE AND XVFB_RUN)
-  # Its own range of display numbers (see vtk/examples).
-  edm_run_demo(${WORK}/xvfb ${XVFB_RUN} -a -n 150 -s "-screen 0 1280x1024x24")
+  # Its own range of display numbers, and no server reset (see vtk/examples).
+  edm_run_demo(${WORK}/xvfb ${XVFB_RUN} -a -n 150 -s "-screen 0 1280x1024x24 -noreset")
   if(demo_out MATCHES "skipped")
     message(FATAL_ERROR "edmodel demo under xvfb-run skipped Figure 1")
   endif()

@@ -42,6 +42,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <thread>
 
 #ifdef EDM_HAVE_XLIB
@@ -94,7 +95,15 @@ WhyNoOffscreenRendering()
     return "cannot open the X display '" + std::string(std::getenv("DISPLAY")) +
            "' and this VTK renders through X only, offscreen included: run under xvfb-run -a";
   }
-  XCloseDisplay(display);
+  // The connection stays open until the program exits: an X server started
+  // without -noreset (xvfb-run's default) resets when its last client
+  // disconnects and drops a client that connects during the reset, which
+  // would be VTK's render window right after this probe (VTK then aborts).
+  static const std::unique_ptr<Display, int (*)(Display *)> probe(display, XCloseDisplay);
+  if (probe.get() != display)
+  {
+    XCloseDisplay(display); // An earlier probe holds the connection.
+  }
 #endif
   return std::string();
 }
