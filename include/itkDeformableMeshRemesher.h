@@ -343,6 +343,14 @@ private:
    * long after a pass that split every long edge). */
   bool
   SplitPass(bool all);
+  /** The squared length of the edge of corner \a c when a split pass splits
+   * it (longer than the maximum, manifold, no end-point frozen), else 0. */
+  double
+  SplittableLength2(IndexType c) const;
+  /** The corner an edge is listed from: the lower of corner \a c and its
+   * twin (or \a c on a boundary). */
+  IndexType
+  ListingCorner(IndexType c) const;
   bool
   SplitWaits(IndexType c) const;
   void
@@ -1139,25 +1147,10 @@ DeformableMeshRemesher::SplitPass(bool all)
   std::vector<std::pair<double, IndexType>> & candidates = m_SplitCandidates;
   candidates.clear();
   const auto consider = [this](IndexType c, std::vector<std::pair<double, IndexType>> & found) {
-    if (m_V[c] == Invalid)
+    const double length2 = this->SplittableLength2(c);
+    if (length2 > 0.0)
     {
-      return;
-    }
-    const Link o = m_O[c];
-    if (o == NonManifold)
-    {
-      return;
-    }
-    const IndexType a = m_V[c];
-    const IndexType b = m_V[Next(c)];
-    if (m_State[a] == RemesherFrozen || m_State[b] == RemesherFrozen)
-    {
-      return;
-    }
-    const double length2 = this->Length2(a, b);
-    if (length2 > m_Max2)
-    {
-      found.emplace_back(length2, o >= 0 && o < static_cast<int64_t>(c) ? static_cast<IndexType>(o) : c);
+      found.emplace_back(length2, this->ListingCorner(c));
     }
   };
   if (all)
@@ -1174,8 +1167,8 @@ DeformableMeshRemesher::SplitPass(bool all)
       [&](std::size_t first, std::size_t last) {
         std::vector<std::pair<double, IndexType>> & part = parts[first / blockSize];
         uint64_t                                    bits = 0;
-        // consider() and ShortEdge() in one, without branches on which
-        // corner lists an edge (half of them, in no order a predictor
+        // consider() (SplittableLength2(), ListingCorner()) and
+        // ShortEdge() in one, without branches on which corner lists an edge (half of them, in no order a predictor
         // follows): each corner's length, the end-points' states only for
         // the long edges, Next() counted along.
         std::size_t k = first % 3;
@@ -1278,21 +1271,44 @@ DeformableMeshRemesher::SplitPass(bool all)
   return any;
 }
 
+inline double
+DeformableMeshRemesher::SplittableLength2(IndexType c) const
+{
+  if (m_V[c] == Invalid || m_O[c] == NonManifold)
+  {
+    return 0.0;
+  }
+  const IndexType a = m_V[c];
+  const IndexType b = m_V[Next(c)];
+  if (m_State[a] == RemesherFrozen || m_State[b] == RemesherFrozen)
+  {
+    return 0.0;
+  }
+  const double length2 = this->Length2(a, b);
+  return length2 > m_Max2 ? length2 : 0.0;
+}
+
+inline DeformableMeshRemesher::IndexType
+DeformableMeshRemesher::ListingCorner(IndexType c) const
+{
+  const Link o = m_O[c];
+  return o >= 0 && o < static_cast<int64_t>(c) ? static_cast<IndexType>(o) : c;
+}
+
 inline bool
 DeformableMeshRemesher::SplitWaits(IndexType c) const
 {
   // Whether another edge of the triangles of corner c is to be split first:
-  // one that a split pass would split (longer than the maximum, manifold,
-  // no end-point frozen) and longer than c's edge (or as long and listed
-  // from a lower corner: a strict order, so that the longest edge of all
-  // never waits).
+  // one that a split pass would split and longer than c's edge (or as long
+  // and listed from a lower corner: a strict order, so that the longest
+  // edge of all never waits).
   const Link o = m_O[c];
   if (m_V[c] == Invalid || o == NonManifold)
   {
     return false;
   }
   const double    length2 = this->Length2(m_V[c], m_V[Next(c)]);
-  const IndexType listed = o >= 0 && o < static_cast<int64_t>(c) ? static_cast<IndexType>(o) : c;
+  const IndexType listed = this->ListingCorner(c);
   for (const Link side : { static_cast<Link>(c), o })
   {
     if (side < 0)
@@ -1302,20 +1318,12 @@ DeformableMeshRemesher::SplitWaits(IndexType c) const
     const auto first = static_cast<IndexType>(side) - static_cast<IndexType>(side) % 3;
     for (IndexType k = first; k < first + 3; ++k)
     {
-      const Link ok = m_O[k];
-      if (k == c || static_cast<Link>(k) == o || ok == NonManifold)
+      if (k == c || static_cast<Link>(k) == o)
       {
         continue;
       }
-      const IndexType a = m_V[k];
-      const IndexType b = m_V[Next(k)];
-      if (m_State[a] == RemesherFrozen || m_State[b] == RemesherFrozen)
-      {
-        continue;
-      }
-      const double    other2 = this->Length2(a, b);
-      const IndexType otherListed = ok >= 0 && ok < static_cast<int64_t>(k) ? static_cast<IndexType>(ok) : k;
-      if (other2 > m_Max2 && (other2 > length2 || (other2 == length2 && otherListed < listed)))
+      const double other2 = this->SplittableLength2(k);
+      if (other2 > length2 || (other2 > 0.0 && other2 == length2 && this->ListingCorner(k) < listed))
       {
         return true;
       }
