@@ -762,9 +762,13 @@ private:
   /** The step's tables from triangles and edges (min << 32 | max, any order,
    * duplicates allowed unless \a edgesUnique; consumed). For a 2-D mesh
    * \a triangles holds the oriented segments of the contours, 2 indices
-   * each (OrientContours()). */
+   * each (OrientContours()). \a orient: the orientation sign found again
+   * from the triangles (see FinishTopology()). */
   void
-  BuildTopology(const std::vector<IndexType32> & triangles, std::vector<uint64_t> & edges, bool edgesUnique = false);
+  BuildTopology(const std::vector<IndexType32> & triangles,
+                std::vector<uint64_t> &          edges,
+                bool                             edgesUnique = false,
+                bool                             orient = true);
 
   /** After a remeshing: the step's tables from the remesher's fans, the
    * same as BuildTopology() gives, without sorting each vertex's pairs;
@@ -772,10 +776,11 @@ private:
   bool
   BuildTopologyFromRemesher();
 
-  /** The end of BuildTopology(): orientation sign, number of triangles,
-   * valence order. */
+  /** The end of BuildTopology(): orientation sign (when \a orient; a
+   * remeshing keeps the sign found at the reset, for the remesher keeps the
+   * triangles' orientation), number of triangles, valence order. */
   void
-  FinishTopology(const std::vector<IndexType32> & triangles);
+  FinishTopology(const std::vector<IndexType32> & triangles, bool orient = true);
 
   /** Renumbers the cached points for locality when their numbering is not
    * local; relabels \a triangles and \a edges. */

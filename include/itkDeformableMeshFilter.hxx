@@ -303,7 +303,8 @@ template <typename TMesh, typename TForceImage>
 void
 DeformableMeshFilter<TMesh, TForceImage>::BuildTopology(const std::vector<IndexType32> & triangles,
                                                         std::vector<uint64_t> &          edges,
-                                                        bool                             edgesUnique)
+                                                        bool                             edgesUnique,
+                                                        bool                             orient)
 {
   using namespace DeformableMeshFilterDetail;
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
@@ -502,7 +503,7 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology(const std::vector<IndexT
     }
   }
 
-  this->FinishTopology(triangles);
+  this->FinishTopology(triangles, orient);
 }
 
 template <typename TMesh, typename TForceImage>
@@ -558,31 +559,38 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopologyFromRemesher()
   m_GeneralVertices.clear();
   m_GeneralPairOffsets.assign(1, 0);
   m_GeneralPairs.clear();
-  this->FinishTopology(m_Triangles);
+  this->FinishTopology(m_Triangles, false);
   return true;
 }
 
 template <typename TMesh, typename TForceImage>
 void
-DeformableMeshFilter<TMesh, TForceImage>::FinishTopology(const std::vector<IndexType32> & triangles)
+DeformableMeshFilter<TMesh, TForceImage>::FinishTopology(const std::vector<IndexType32> & triangles, bool orient)
 {
   using namespace DeformableMeshFilterDetail;
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
   // 2-D: \a triangles holds the contours' segments, oriented contour by
   // contour (OrientContours()): the sign is +1.
   const SizeValueType numberOfTriangles = PointDimension == 2 ? 0 : triangles.size() / 3;
-  // Outward orientation from the signed volume enclosed by the triangles.
-  const double * x = this->GetCoordinates().data();
-  double         volume = 0.0;
-  for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+  if (orient)
   {
-    const double * a = x + 3 * triangles[3 * t];
-    const double * b = x + 3 * triangles[3 * t + 1];
-    const double * c = x + 3 * triangles[3 * t + 2];
-    volume +=
-      a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
+    // Outward orientation from the signed volume enclosed by the triangles.
+    // Not after a remeshing: the remesher keeps the triangles' orientation,
+    // and the sign found at the reset stays (found again, it could change
+    // with the shape of an open surface, whose "volume" is that of the cone
+    // from the origin; and it is a serial pass over the triangles).
+    const double * x = this->GetCoordinates().data();
+    double         volume = 0.0;
+    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+    {
+      const double * a = x + 3 * triangles[3 * t];
+      const double * b = x + 3 * triangles[3 * t + 1];
+      const double * c = x + 3 * triangles[3 * t + 2];
+      volume +=
+        a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
+    }
+    m_OrientationSign = volume < 0.0 ? -1.0 : 1.0;
   }
-  m_OrientationSign = volume < 0.0 ? -1.0 : 1.0;
   m_NumberOfTriangles = numberOfTriangles;
 
   // The step has straight-line code for 4 to 8 neighbours, chosen by a jump
@@ -1670,7 +1678,7 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
   {
     std::vector<uint64_t> edges;
     const bool            unique = m_Remesher.Edges(edges);
-    this->BuildTopology(m_Triangles, edges, unique);
+    this->BuildTopology(m_Triangles, edges, unique, false);
   }
   ++m_NumberOfRemeshings;
   // The remesher never moves a boundary vertex and splits boundary edges at

@@ -1007,3 +1007,80 @@ TEST(DeformableMeshRenumbering, ARegularSphereSourceIsRenumberedAndGivesTheSameS
   filter->Print(os);
   EXPECT_NE(os.str().find("Renumbered: false"), std::string::npos);
 }
+
+TEST(DeformableMeshRemeshing, KeepsTheOrientationFoundAtTheReset)
+{
+  // An open surface, a flat grid of 8 x 8 squares at z = 1, carried by a
+  // uniform force (0, 0, -1) through the plane z = 0 to z = -1 and remeshed
+  // every 10 iterations. Its signed "volume", that of the cone from the
+  // origin, changes sign as it crosses z = 0; the orientation the step uses
+  // (the side the balloon and the normals point to) must stay the one found
+  // at the reset: the remesher keeps the triangles' orientation.
+  const FlatMesh grid = FlatGrid(8, 1.0);
+  auto           mesh = MeshType::New();
+  for (std::size_t i = 0; i < grid.Points(); ++i)
+  {
+    PointType p;
+    p[0] = grid.x[3 * i] - 4.0;
+    p[1] = grid.x[3 * i + 1] - 4.0;
+    p[2] = 1.0;
+    mesh->SetPoint(i, p);
+  }
+  for (std::size_t t = 0; t < grid.triangles.size() / 3; ++t)
+  {
+    MeshType::CellAutoPointer cell;
+    cell.TakeOwnership(new itk::TriangleCell<MeshType::CellType>);
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      cell->SetPointId(k, grid.triangles[3 * t + k]);
+    }
+    mesh->SetCell(t, cell);
+  }
+  auto                     forces = ForceImageType::New();
+  ForceImageType::SizeType size;
+  size.Fill(17);
+  forces->SetRegions(size);
+  ForceImageType::PointType origin;
+  origin.Fill(-8.0);
+  forces->SetOrigin(origin);
+  forces->Allocate();
+  ForceImageType::PixelType down;
+  down[0] = 0.0f;
+  down[1] = 0.0f;
+  down[2] = -1.0f;
+  forces->FillBuffer(down);
+
+  const auto volume = [](const FlatMesh & m) {
+    double v = 0.0;
+    for (std::size_t t = 0; t < m.triangles.size(); t += 3)
+    {
+      const double * a = m.x.data() + 3 * m.triangles[t];
+      const double * b = m.x.data() + 3 * m.triangles[t + 1];
+      const double * c = m.x.data() + 3 * m.triangles[t + 2];
+      v += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
+    }
+    return v;
+  };
+  auto filter = FilterType::New();
+  filter->SetInput(mesh);
+  filter->SetForceImage(forces);
+  filter->SetScaleFactor(0.05);
+  filter->SetElasticity(0.0);
+  filter->SetRigidity(0.0);
+  filter->SetRemeshingEdgeLength(0.8);
+  filter->SetRemeshingInterval(10);
+  filter->SetIterateFromZero(false);
+  filter->SetNumberOfIterations(1);
+  filter->Update();
+  const double atReset = filter->GetOrientationSign();
+  const double volumeAtReset = volume(ToFlat(mesh));
+  EXPECT_EQ(atReset, volumeAtReset < 0.0 ? -1.0 : 1.0) << "the reset finds the sign from the volume";
+  filter->SetNumberOfIterations(40);
+  filter->Update();
+  const FlatMesh out = OutputOf(filter);
+  EXPECT_EQ(filter->GetNumberOfRemeshings(), 4u);
+  EXPECT_GT(filter->GetRemeshingStatistics().splits, 0u) << "the remeshings changed the mesh";
+  EXPECT_NEAR(out.x[2], -1.0, 1e-4) << "carried to z = -1";
+  EXPECT_LT(volume(out) * volumeAtReset, 0.0) << "the cone's volume changed sign";
+  EXPECT_EQ(filter->GetOrientationSign(), atReset);
+}
