@@ -83,6 +83,33 @@ ToFlat(const MeshType * mesh)
   return f;
 }
 
+/** The mesh of \a m, each point moved by \a shift. */
+MeshType::Pointer
+ToMesh(const FlatMesh & m, const std::array<double, 3> & shift)
+{
+  auto mesh = MeshType::New();
+  for (std::size_t i = 0; i < m.Points(); ++i)
+  {
+    PointType p;
+    for (unsigned int d = 0; d < 3; ++d)
+    {
+      p[d] = m.x[3 * i + d] + shift[d];
+    }
+    mesh->SetPoint(i, p);
+  }
+  for (std::size_t t = 0; t < m.triangles.size() / 3; ++t)
+  {
+    MeshType::CellAutoPointer cell;
+    cell.TakeOwnership(new itk::TriangleCell<MeshType::CellType>);
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      cell->SetPointId(k, m.triangles[3 * t + k]);
+    }
+    mesh->SetCell(t, cell);
+  }
+  return mesh;
+}
+
 double
 EdgeLength(const FlatMesh & m, IndexType a, IndexType b)
 {
@@ -980,27 +1007,8 @@ TEST(DeformableMeshRenumbering, ARegularSphereSourceIsRenumberedAndGivesTheSameS
   EXPECT_LT(diagnosticError, 1e-5f);
 
   // A well-numbered mesh (the flat grid's rows) is left as it is.
-  FlatMesh grid = FlatGrid(100, 1.0);
-  auto     mesh = MeshType::New();
-  for (std::size_t i = 0; i < grid.Points(); ++i)
-  {
-    PointType p;
-    p[0] = grid.x[3 * i] - 2.5;
-    p[1] = grid.x[3 * i + 1] - 2.5;
-    p[2] = 47.5;
-    mesh->SetPoint(i, p);
-  }
-  for (std::size_t t = 0; t < grid.triangles.size() / 3; ++t)
-  {
-    MeshType::CellAutoPointer cell;
-    cell.TakeOwnership(new itk::TriangleCell<MeshType::CellType>);
-    for (unsigned int k = 0; k < 3; ++k)
-    {
-      cell->SetPointId(k, grid.triangles[3 * t + k]);
-    }
-    mesh->SetCell(t, cell);
-  }
-  auto filter = c.MakeFilter(0.0, 1);
+  const auto mesh = ToMesh(FlatGrid(100, 1.0), { -2.5, -2.5, 47.5 });
+  auto       filter = c.MakeFilter(0.0, 1);
   filter->SetInput(mesh);
   filter->Update();
   std::ostringstream os;
@@ -1016,26 +1024,7 @@ TEST(DeformableMeshRemeshing, KeepsTheOrientationFoundAtTheReset)
   // origin, changes sign as it crosses z = 0; the orientation the step uses
   // (the side the balloon and the normals point to) must stay the one found
   // at the reset: the remesher keeps the triangles' orientation.
-  const FlatMesh grid = FlatGrid(8, 1.0);
-  auto           mesh = MeshType::New();
-  for (std::size_t i = 0; i < grid.Points(); ++i)
-  {
-    PointType p;
-    p[0] = grid.x[3 * i] - 4.0;
-    p[1] = grid.x[3 * i + 1] - 4.0;
-    p[2] = 1.0;
-    mesh->SetPoint(i, p);
-  }
-  for (std::size_t t = 0; t < grid.triangles.size() / 3; ++t)
-  {
-    MeshType::CellAutoPointer cell;
-    cell.TakeOwnership(new itk::TriangleCell<MeshType::CellType>);
-    for (unsigned int k = 0; k < 3; ++k)
-    {
-      cell->SetPointId(k, grid.triangles[3 * t + k]);
-    }
-    mesh->SetCell(t, cell);
-  }
+  const auto               mesh = ToMesh(FlatGrid(8, 1.0), { -4.0, -4.0, 1.0 });
   auto                     forces = ForceImageType::New();
   ForceImageType::SizeType size;
   size.Fill(17);
