@@ -1168,9 +1168,10 @@ DeformableMeshRemesher::SplitPass(bool all)
         std::vector<std::pair<double, IndexType>> & part = parts[first / blockSize];
         uint64_t                                    bits = 0;
         // consider() (SplittableLength2(), ListingCorner()) and
-        // ShortEdge() in one, without branches on which corner lists an edge (half of them, in no order a predictor
-        // follows): each corner's length, the end-points' states only for
-        // the long edges, Next() counted along.
+        // ShortEdge() in one, without branches on which corner lists an
+        // edge (half of them, in no order a predictor follows): each
+        // corner's length, the end-points' states only for the long edges,
+        // Next() counted along.
         std::size_t k = first % 3;
         for (std::size_t c = first; c < last; ++c, k = k == 2 ? 0 : k + 1)
         {
