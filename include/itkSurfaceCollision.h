@@ -3004,14 +3004,16 @@ private:
     // products of the orientation determinant is at most S^3, which bounds
     // its rounding error for all triangles at once (the filter of
     // Orient3DFilteredSign() with 6 S^3 for the permanent).
-    m_StarDifferences.resize(3 * n);
+    // The differences are not stored: the passes below form them again
+    // from x (the same subtraction, so the same bits), which reads less
+    // memory than an array of them written here and read back.
     m_StarSides.resize(n);
     std::vector<double> largest((n + block - 1) / block, 0.0);
     parallel(n, [&](SizeValueType begin, SizeValueType end) {
       double m = 0.0;
       for (SizeValueType i = begin; i < end; ++i)
       {
-        double * q = m_StarDifferences.data() + 3 * i;
+        double q[3];
         SurfaceCollisionDetail::Subtract(x + 3 * i, centre, q);
         const double p1 = q[0] * e1[0] + q[1] * e1[1] + q[2] * e1[2];
         const double p2 = q[0] * e2[0] + q[1] * e2[1] + q[2] * e2[2];
@@ -3025,7 +3027,6 @@ private:
     // 6 S^3 (1e-15 as in Orient3DFilteredSign()); infinite or not a number
     // when S^3 overflows: then every sign goes to the exact test.
     const double        sharedBound = 6e-15 * magnitude * magnitude * magnitude;
-    const double *      differences = m_StarDifferences.data();
     const uint8_t *     sides = m_StarSides.data();
     const SizeValueType blocks = (numberOfTriangles + block - 1) / block;
     // Per block: positive and negative orientations, ray crossings (of
@@ -3037,7 +3038,7 @@ private:
       for (SizeValueType t = begin; t < end; ++t)
       {
         const IndexType * vt = m_Triangles.data() + 3 * t;
-        const int         orientation = StarOrientation(x, differences, vt, centre, sharedBound);
+        const int         orientation = StarOrientation(x, vt, centre, sharedBound);
         if (orientation == 0)
         {
           ++c[3];
@@ -3118,7 +3119,6 @@ private:
       return false;
     }
     const SizeValueType     numberOfTriangles = this->GetNumberOfTriangles();
-    const double *          differences = m_StarDifferences.data();
     const double *          centre = summary.centre;
     constexpr SizeValueType block = SurfaceCollisionDetail::ParallelBlocks::Block;
     const SizeValueType     blocks = (numberOfTriangles + block - 1) / block;
@@ -3127,12 +3127,13 @@ private:
     // (a cap of less than a quarter sphere is convex on the sphere). Caps
     // of more than 84 degrees are taken as meeting everything.
     constexpr double widest = 0.1; // cosine of the widest cap measured
-    const auto       cap = [differences](const IndexType * vt, double axis[3]) {
+    const auto       cap = [x, centre](const IndexType * vt, double axis[3]) {
       double u[3][3];
       for (unsigned int k = 0; k < 3; ++k)
       {
-        const double * q = differences + 3 * static_cast<SizeValueType>(vt[k]);
-        const double   length = std::sqrt(Dot(q, q));
+        double q[3];
+        SurfaceCollisionDetail::Subtract(x + 3 * static_cast<SizeValueType>(vt[k]), centre, q);
+        const double length = std::sqrt(Dot(q, q));
         for (unsigned int d = 0; d < 3; ++d)
         {
           u[k][d] = q[d] / length;
@@ -3159,7 +3160,7 @@ private:
     parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
       for (SizeValueType t = begin; t < end; ++t)
       {
-        if (StarOrientation(x, differences, m_Triangles.data() + 3 * t, centre, summary.sharedBound) == -majority)
+        if (StarOrientation(x, m_Triangles.data() + 3 * t, centre, summary.sharedBound) == -majority)
         {
           parts[begin / block].push_back(static_cast<IndexType>(t));
         }
@@ -3275,25 +3276,24 @@ private:
   static constexpr SizeValueType MaximumFoldTriangles = 256;
   static constexpr SizeValueType MaximumFoldNeighbourhood = 4096;
 
-  /** The orientation of triangle \a vt seen from \a centre, from
-   * StarShaped()'s \a differences (x - centre, rounded) and its bound of
-   * their rounding: 1, -1, or 0 when the centre lies in the triangle's
-   * plane (exact sign). */
+  /** The orientation of triangle \a vt seen from \a centre, from the
+   * differences x - centre (rounded) and StarShaped()'s bound of their
+   * rounding: 1, -1, or 0 when the centre lies in the triangle's plane
+   * (exact sign). */
   static int
-  StarOrientation(const double *    x,
-                  const double *    differences,
-                  const IndexType * vt,
-                  const double *    centre,
-                  double            sharedBound)
+  StarOrientation(const double * x, const IndexType * vt, const double * centre, double sharedBound)
   {
-    const double * q0 = differences + 3 * vt[0];
-    const double * q1 = differences + 3 * vt[1];
-    const double * q2 = differences + 3 * vt[2];
-    const double   m0 = q0[1] * q1[2] - q0[2] * q1[1];
-    const double   m1 = q0[2] * q1[0] - q0[0] * q1[2];
-    const double   m2 = q0[0] * q1[1] - q0[1] * q1[0];
-    const double   det = m0 * q2[0] + m1 * q2[1] + m2 * q2[2];
-    int            orientation = det > sharedBound ? 1 : (det < -sharedBound ? -1 : 0);
+    double q0[3];
+    double q1[3];
+    double q2[3];
+    SurfaceCollisionDetail::Subtract(x + 3 * static_cast<SizeValueType>(vt[0]), centre, q0);
+    SurfaceCollisionDetail::Subtract(x + 3 * static_cast<SizeValueType>(vt[1]), centre, q1);
+    SurfaceCollisionDetail::Subtract(x + 3 * static_cast<SizeValueType>(vt[2]), centre, q2);
+    const double m0 = q0[1] * q1[2] - q0[2] * q1[1];
+    const double m1 = q0[2] * q1[0] - q0[0] * q1[2];
+    const double m2 = q0[0] * q1[1] - q0[1] * q1[0];
+    const double det = m0 * q2[0] + m1 * q2[1] + m2 * q2[2];
+    int          orientation = det > sharedBound ? 1 : (det < -sharedBound ? -1 : 0);
     if (orientation == 0)
     {
       orientation = SurfaceCollisionDetail::Orient3DFilteredSign(q0, q1, q2);
@@ -4428,8 +4428,7 @@ private:
 
   SizeValueType m_NumberOfPoints{ 0 };
   bool          m_HasSurface{ false };
-  // StarShaped()'s per-point differences and sides, kept between calls.
-  mutable std::vector<double>  m_StarDifferences;
+  // StarShaped()'s per-point sides, kept between calls.
   mutable std::vector<uint8_t> m_StarSides;
   std::vector<IndexType>       m_Triangles;
   std::vector<SizeValueType>   m_VertexTriangleOffsets;
