@@ -663,8 +663,9 @@ public:
   itkBooleanMacro(RenumberForLocality);
 
   /** Sign applied to the triangles' orientation to get outward normals: +1 for
-   * an outward-oriented mesh, -1 for an inward-oriented one. Set by Reset().
-   * Always +1 for 2-D contours, whose orientation is normalised contour by
+   * an outward-oriented mesh, -1 for an inward-oriented one. Set by Reset()
+   * from the signed volume of the triangles and kept across remeshings
+   * (which keep the triangles' orientation). Always +1 for 2-D contours, whose orientation is normalised contour by
    * contour (see the class documentation). */
   itkGetConstMacro(OrientationSign, double);
 
