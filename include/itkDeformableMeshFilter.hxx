@@ -1609,6 +1609,7 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
   x.resize(3 * numberOfPoints); // the guard value goes
   m_Remesher.SetTargetEdgeLength(m_RemeshingEdgeLength);
   m_Remesher.SetMultiThreader(this->GetMultiThreader(), this->GetNumberOfWorkUnits());
+  m_Remesher.SetIncremental(true);
   m_NumberOfPointsLockedByRemeshing = 0;
   if (m_PreventSelfIntersections)
   {
@@ -1708,29 +1709,15 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
 {
   std::vector<double> & x = this->GetCoordinates();
   const SizeValueType   numberOfPoints = before.size() / 3;
-  // The input's triangles as sorted triples of point indices, sorted (made
-  // when first needed): a remeshed triangle whose points did not move and
-  // whose triple of parents is one of these is the input's triangle,
-  // unchanged.
+  // Triangles as sorted triples of point indices (of the input's points).
   using Triple = std::array<IndexType32, 3>;
   const auto sorted = [](IndexType32 a, IndexType32 b, IndexType32 c) {
     Triple t{ { a, b, c } };
     std::sort(t.begin(), t.end());
     return t;
   };
-  std::vector<Triple> inputTriangles;
-  const auto          isInputTriangle = [&](const Triple & triple) {
-    if (inputTriangles.empty())
-    {
-      inputTriangles.resize(beforeTriangles.size() / 3);
-      for (SizeValueType t = 0; t < inputTriangles.size(); ++t)
-      {
-        inputTriangles[t] = sorted(beforeTriangles[3 * t], beforeTriangles[3 * t + 1], beforeTriangles[3 * t + 2]);
-      }
-      std::sort(inputTriangles.begin(), inputTriangles.end());
-    }
-    return std::binary_search(inputTriangles.begin(), inputTriangles.end(), triple);
-  };
+  std::vector<std::pair<Triple, SizeValueType>> candidates;
+  std::vector<uint8_t>                          candidatePoint;
 
   std::vector<uint8_t> locked(numberOfPoints, 0);
   std::vector<uint8_t> changed;
@@ -1746,8 +1733,11 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
       return x[3 * v] != before[3 * p] || x[3 * v + 1] != before[3 * p + 1] || x[3 * v + 2] != before[3 * p + 2];
     };
     // In parallel, whether each point moved, then whether a triangle's
-    // points did (2: none did, the input's triangles decide, below and in
-    // order, in the blocks that have such triangles).
+    // points did. A triangle whose points did not move and around none of
+    // which the remesher changed the triangles is the input's (0); 2: its
+    // points did not move but one's triangles changed, the input's
+    // triangles decide, below and in order, in the blocks that have such
+    // triangles.
     const SizeValueType     remeshedPoints = parents.size();
     constexpr SizeValueType block = 16384;
     MultiThreaderBase *     threader = this->GetMultiThreader();
@@ -1774,12 +1764,26 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
         for (SizeValueType t = b * block; t < std::min(remeshedTriangles, (b + 1) * block); ++t)
         {
           const IndexType32 * v = m_Triangles.data() + 3 * t;
-          changed[t] = (pointMoved[v[0]] | pointMoved[v[1]] | pointMoved[v[2]]) != 0 ? 1 : 2;
+          if ((pointMoved[v[0]] | pointMoved[v[1]] | pointMoved[v[2]]) != 0)
+          {
+            changed[t] = 1;
+          }
+          else
+          {
+            changed[t] = m_Remesher.OutputPointChanged(v[0]) || m_Remesher.OutputPointChanged(v[1]) ||
+                             m_Remesher.OutputPointChanged(v[2])
+                           ? 2
+                           : 0;
+          }
           unmoved |= changed[t] == 2 ? 1 : 0;
         }
         blockUnmoved[b] = unmoved;
       },
       nullptr);
+    // The remeshed triangles marked 2, as triples of their points' parents,
+    // looked up among the input's triangles in one pass over them (those all
+    // of whose points are parents of a candidate's).
+    candidates.clear();
     for (SizeValueType b = 0; b < triangleBlocks; ++b)
     {
       for (SizeValueType t = b * block; blockUnmoved[b] != 0 && t < std::min(remeshedTriangles, (b + 1) * block); ++t)
@@ -1787,7 +1791,35 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
         if (changed[t] == 2)
         {
           const IndexType32 * v = m_Triangles.data() + 3 * t;
-          changed[t] = isInputTriangle(sorted(parents[v[0]], parents[v[1]], parents[v[2]])) ? 0 : 1;
+          candidates.emplace_back(sorted(parents[v[0]], parents[v[1]], parents[v[2]]), t);
+          changed[t] = 1;
+        }
+      }
+    }
+    if (!candidates.empty())
+    {
+      std::sort(candidates.begin(), candidates.end());
+      candidatePoint.assign(numberOfPoints, 0);
+      for (const auto & candidate : candidates)
+      {
+        for (const IndexType32 p : candidate.first)
+        {
+          candidatePoint[p] = 1;
+        }
+      }
+      for (SizeValueType t = 0; t < beforeTriangles.size() / 3; ++t)
+      {
+        const IndexType32 * v = beforeTriangles.data() + 3 * t;
+        if ((candidatePoint[v[0]] & candidatePoint[v[1]] & candidatePoint[v[2]]) == 0)
+        {
+          continue;
+        }
+        const Triple triple = sorted(v[0], v[1], v[2]);
+        auto         it = std::lower_bound(
+          candidates.begin(), candidates.end(), triple, [](const auto & c, const Triple & k) { return c.first < k; });
+        for (; it != candidates.end() && it->first == triple; ++it)
+        {
+          changed[it->second] = 0; // the input's triangle, its points unmoved
         }
       }
     }

@@ -179,6 +179,30 @@ public:
     m_RelaxationSweeps = sweeps;
   }
 
+  /** Incremental remeshing of a mesh that moves. When on, and the input of
+   * Remesh() is the last output (the same triangles: the corner table is
+   * kept), the flip pass and the relaxation visit only where the
+   * connectivity changed since the last flip pass: the flip pass the edges
+   * with an end-point or an opposite point that an operation (split,
+   * collapse, flip) touched, the relaxation those points and their
+   * neighbours. The splits and collapses still test every edge. Elsewhere
+   * the valences are as the last flip pass left them and the points as the
+   * last relaxation left them, moved since by the caller: DeformableMeshFilter,
+   * whose internal forces keep the points spread along the surface between
+   * two remeshings, turns it on. A first Remesh(), one after ForgetTable() or
+   * with locked vertices, or of another mesh, visits the whole mesh.
+   * Default: off (each Remesh() flips and relaxes everywhere). */
+  void
+  SetIncremental(bool incremental)
+  {
+    m_Incremental = incremental;
+  }
+  bool
+  GetIncremental() const
+  {
+    return m_Incremental;
+  }
+
   /** Vertices of the next Remesh()'s input (a flag per input vertex, 1:
    * locked) that no operation touches, as if frozen: they do not move, and
    * no edge with a locked end-point is split, collapsed or flipped (nor
@@ -238,7 +262,8 @@ public:
    * builds it from its input. Remesh() keeps the table of its output and
    * reuses it when it is given that output again (the next remeshing of a
    * mesh that only moved), which saves building it; the result is the same
-   * either way. */
+   * either way unless Incremental is on (the next Remesh() then visits the
+   * whole mesh). */
   void
   ForgetTable()
   {
@@ -260,6 +285,17 @@ public:
   OutputValence(IndexType v) const
   {
     return m_TableValid && v < m_Valence.size() ? static_cast<std::size_t>(m_Valence[v]) : 0;
+  }
+
+  /** Whether an operation (split, collapse, flip) of the last Remesh()
+   * changed the triangles around vertex \a v of its output. An output
+   * triangle none of whose vertices was changed is one of the input's
+   * triangles, with the same points (Parents()), moved by the relaxation at
+   * most. */
+  bool
+  OutputPointChanged(IndexType v) const
+  {
+    return v < m_Touched.size() && (m_Touched[v] & TouchedNow) != 0;
   }
 
   /** For each vertex of the last Remesh()'s output, the input vertex it
@@ -369,7 +405,7 @@ private:
   /** The cheap part of TryFlip(c): an interior edge listed from c whose
    * flip would bring the valences closer to 6 (4 on a boundary). */
   bool
-  FlipImprovesValences(IndexType c) const;
+  FlipImprovesValences(IndexType c, bool touchedOnly) const;
   void
   Relax();
   /** Moves the end-points of each edge still shorter than the minimum apart
@@ -538,6 +574,7 @@ private:
   double              m_MinimumRatio{ 0.8 };
   double              m_MaximumRatio{ 4.0 / 3.0 };
   unsigned int        m_RelaxationSweeps{ 1 };
+  bool                m_Incremental{ false };
 
   // Corner table: corner c = 3 t + k is vertex m_V[c] of triangle t; the
   // half-edge of corner c goes from m_V[c] to m_V[Next(c)]; m_O[c] is the
@@ -550,7 +587,20 @@ private:
   std::vector<double>    m_X;
   std::vector<IndexType> m_Parents;
   bool                   m_TableValid{ false };
-  std::vector<uint8_t>   m_Locked;       // SetLockedVertices(), for the next Remesh()
+  std::vector<uint8_t>   m_Locked; // SetLockedVertices(), for the next Remesh()
+  // Per point: TouchedSinceFlips when an operation changed its fan since the
+  // last flip pass (every point of a table just built), TouchedNow when one
+  // did in the running (or last) Remesh(). Incremental (m_Local): the flip
+  // pass and relaxation visit the first ones (and their rings, marked in
+  // m_RelaxSet).
+  enum : uint8_t
+  {
+    TouchedSinceFlips = 1,
+    TouchedNow = 2
+  };
+  std::vector<uint8_t>   m_Touched;
+  std::vector<uint8_t>   m_RelaxSet;
+  bool                   m_Local{ false };
   std::vector<IndexType> m_SplitTouched; // triangles the splits of a pass changed or made
   // The short edges found by the scan of SplitPass(true), a bit per corner
   // as CollapsePass() lists them, and the triangles whose corners the
@@ -588,6 +638,7 @@ private:
   std::vector<IndexType>                    m_Start;
   std::vector<IndexType>                    m_ScratchParents;
   std::vector<uint8_t>                      m_ScratchState;
+  std::vector<uint8_t>                      m_ScratchTouched;
   std::vector<int32_t>                      m_ScratchValence;
   std::vector<Link>                         m_ScratchO;
 };
@@ -648,6 +699,7 @@ DeformableMeshRemesher::NewVertex(const double * p, IndexType parent)
   m_VertexCorner.push_back(Invalid);
   m_Valence.push_back(0);
   m_State.push_back(RemesherFree);
+  m_Touched.push_back(TouchedSinceFlips | TouchedNow);
   m_Parents.push_back(parent);
   return v;
 }
@@ -914,6 +966,7 @@ DeformableMeshRemesher::Build(std::size_t numberOfPoints)
   m_VertexCorner.assign(numberOfPoints, Invalid);
   m_State.assign(numberOfPoints, RemesherFree);
   m_Valence.assign(numberOfPoints, 0);
+  m_Touched.assign(numberOfPoints, TouchedSinceFlips);
   for (std::size_t i = 0; i < numberOfPoints; ++i)
   {
     if (offsets[i] == offsets[i + 1])
@@ -1076,6 +1129,9 @@ DeformableMeshRemesher::Split(IndexType c)
   m_VertexCorner[m] = t2;
   ++m_Valence[C];
   m_Valence[m] = 3;
+  m_Touched[a] = TouchedSinceFlips | TouchedNow;
+  m_Touched[b] = TouchedSinceFlips | TouchedNow;
+  m_Touched[C] = TouchedSinceFlips | TouchedNow;
 
   if (o >= 0)
   {
@@ -1108,6 +1164,7 @@ DeformableMeshRemesher::Split(IndexType c)
     }
     ++m_Valence[D];
     m_Valence[m] = 4;
+    m_Touched[D] = TouchedSinceFlips | TouchedNow;
   }
   else
   {
@@ -1504,6 +1561,9 @@ DeformableMeshRemesher::TryCollapse(SweepWorker & worker, IndexType c, bool from
   m_Valence[a] = m_Valence[a] + m_Valence[b] - 4;
   --m_Valence[C];
   --m_Valence[D];
+  m_Touched[a] = TouchedSinceFlips | TouchedNow;
+  m_Touched[C] = TouchedSinceFlips | TouchedNow;
+  m_Touched[D] = TouchedSinceFlips | TouchedNow;
   m_State[b] = RemesherRemoved;
   std::copy(mid, mid + 3, m_X.data() + 3 * static_cast<std::size_t>(a));
   ++worker.collapses;
@@ -1578,7 +1638,7 @@ DeformableMeshRemesher::CollapsePass()
 }
 
 inline bool
-DeformableMeshRemesher::FlipImprovesValences(IndexType c) const
+DeformableMeshRemesher::FlipImprovesValences(IndexType c, bool touchedOnly) const
 {
   const Link o = m_O[c];
   if (o < static_cast<int64_t>(c))
@@ -1591,6 +1651,10 @@ DeformableMeshRemesher::FlipImprovesValences(IndexType c) const
   const IndexType D = m_V[Prev(static_cast<IndexType>(o))];
   if (C == D || m_State[a] >= RemesherFrozen || m_State[b] >= RemesherFrozen || m_State[C] >= RemesherFrozen ||
       m_State[D] >= RemesherFrozen)
+  {
+    return false;
+  }
+  if (touchedOnly && ((m_Touched[a] | m_Touched[b] | m_Touched[C] | m_Touched[D]) & TouchedSinceFlips) == 0)
   {
     return false;
   }
@@ -1727,6 +1791,10 @@ DeformableMeshRemesher::TryFlip(SweepWorker & worker, IndexType c, bool lengthen
   --m_Valence[b];
   ++m_Valence[C];
   ++m_Valence[D];
+  for (const IndexType v : { a, b, C, D })
+  {
+    m_Touched[v] = TouchedSinceFlips | TouchedNow;
+  }
   ++worker.flips;
   if (worker.inputs == SweepInputs::Valences)
   {
@@ -1753,7 +1821,7 @@ DeformableMeshRemesher::FlipPass()
   m_StillShortValid = false;
   this->Sweep(
     SweepInputs::Valences,
-    [this](IndexType c) { return m_V[c] != Invalid && this->FlipImprovesValences(c); },
+    [this](IndexType c) { return m_V[c] != Invalid && this->FlipImprovesValences(c, m_Local); },
     [this](SweepWorker & worker, IndexType c) {
       if (m_V[c] != Invalid && m_O[c] >= static_cast<int64_t>(c))
       {
@@ -1781,7 +1849,8 @@ DeformableMeshRemesher::Relax()
     std::size_t            count = 0;
     for (std::size_t i = first; i < last; ++i)
     {
-      if (m_State[i] != RemesherFree || !this->Ring(static_cast<IndexType>(i), ring, &corners))
+      if (m_State[i] != RemesherFree || (m_Local && m_RelaxSet[i] == 0) ||
+          !this->Ring(static_cast<IndexType>(i), ring, &corners))
       {
         continue;
       }
@@ -2063,9 +2132,11 @@ DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<I
     newIndex.assign(numberOfPoints, Invalid);
     std::vector<IndexType> & parents = m_ScratchParents;
     std::vector<uint8_t> &   state = m_ScratchState;
+    std::vector<uint8_t> &   touched = m_ScratchTouched;
     std::vector<int32_t> &   valence = m_ScratchValence;
     parents.resize(kept);
     state.resize(kept);
+    touched.resize(kept);
     valence.resize(kept);
     coordinates.resize(3 * static_cast<std::size_t>(kept));
     for (std::size_t i = 0; i < numberOfPoints; ++i)
@@ -2076,12 +2147,14 @@ DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<I
         newIndex[i] = k;
         parents[k] = root[i];
         state[k] = m_State[i];
+        touched[k] = m_Touched[i];
         valence[k] = m_Valence[i];
         std::copy(m_X.data() + 3 * i, m_X.data() + 3 * i + 3, coordinates.data() + 3 * static_cast<std::size_t>(k));
       }
     }
     m_Parents.swap(parents);
     m_State.swap(state);
+    m_Touched.swap(touched);
     m_Valence.swap(valence);
 
     // The corner table in the new numbering: the remaining triangles
@@ -2259,13 +2332,47 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
     }
   }
   m_TableValid = true;
+  m_Local = m_Incremental && reuse;
+  if (!m_Local)
+  {
+    m_Touched.assign(m_State.size(), TouchedSinceFlips);
+  }
+  else
+  {
+    for (uint8_t & touched : m_Touched)
+    {
+      touched &= TouchedSinceFlips;
+    }
+  }
   for (unsigned int pass = 0; pass < 16 && this->SplitPass(pass == 0); ++pass)
   {}
   this->CollapsePass();
   this->FlipPass();
+  if (m_Local)
+  {
+    // The points of the triangles with a touched point: the touched points
+    // and their rings.
+    m_RelaxSet.assign(m_State.size(), 0);
+    const std::size_t numberOfCorners = m_V.size();
+    for (std::size_t c = 0; c < numberOfCorners; c += 3)
+    {
+      const IndexType a = m_V[c];
+      if (a != Invalid && ((m_Touched[a] | m_Touched[m_V[c + 1]] | m_Touched[m_V[c + 2]]) & TouchedSinceFlips) != 0)
+      {
+        m_RelaxSet[a] = 1;
+        m_RelaxSet[m_V[c + 1]] = 1;
+        m_RelaxSet[m_V[c + 2]] = 1;
+      }
+    }
+  }
   for (unsigned int sweep = 0; sweep < m_RelaxationSweeps; ++sweep)
   {
     this->Relax();
+  }
+  // From here on, what the next Remesh() flips and relaxes.
+  for (uint8_t & touched : m_Touched)
+  {
+    touched &= TouchedNow;
   }
   for (unsigned int pass = 0; pass < 16 && this->SplitPass(pass == 0); ++pass)
   {}

@@ -455,6 +455,118 @@ TEST(DeformableMeshRemesher, KeptTableGivesTheSameMeshAsAFreshOne)
   EXPECT_GT(statistics.relaxed, 0u);
 }
 
+TEST(DeformableMeshRemesher, IncrementalRemeshingMovesNothingFarFromItsOperations)
+{
+  // A sphere remeshed until a round makes no operation, then a cap (z > 7)
+  // stretched along z to twice its height: its edges leave the band.
+  // Incremental, the next Remesh() of that mesh (the same triangles: the
+  // table is kept) splits the cap's edges and flips and relaxes around its
+  // operations only: every point far below the cap keeps its position to
+  // the bit. Not incremental, or with the table forgotten, the relaxation
+  // moves points everywhere. Both outputs are closed 2-manifolds with their
+  // edges in the band.
+  PointType centre;
+  centre.Fill(0.0);
+  const auto                  sphere = itk::MakeSphereMesh<MeshType>(centre, 10.0, 3);
+  FlatMesh                    settled = ToFlat(sphere);
+  itk::DeformableMeshRemesher incremental;
+  itk::DeformableMeshRemesher everywhere;
+  incremental.SetTargetEdgeLength(1.5);
+  everywhere.SetTargetEdgeLength(1.5);
+  EXPECT_FALSE(incremental.GetIncremental()) << "off by default";
+  // The static sphere settles into a cycle of a few operations per round.
+  itk::DeformableMeshRemesher::Statistics statistics;
+  for (int round = 0; round < 30; ++round)
+  {
+    FlatMesh copy = settled;
+    statistics = incremental.Remesh(settled.x, settled.Points(), settled.triangles);
+    everywhere.Remesh(copy.x, copy.Points(), copy.triangles);
+    ASSERT_EQ(settled.x, copy.x);
+  }
+  ASSERT_LE(statistics.splits + statistics.collapses + statistics.flips, 4u);
+  // The points around which the last round operated: the next may flip and
+  // relax around them.
+  std::vector<std::array<double, 3>> operatedAt;
+  for (std::size_t v = 0; v < settled.Points(); ++v)
+  {
+    if (incremental.OutputPointChanged(static_cast<IndexType>(v)))
+    {
+      operatedAt.push_back({ { settled.x[3 * v], settled.x[3 * v + 1], settled.x[3 * v + 2] } });
+    }
+  }
+  EXPECT_LE(operatedAt.size(), 16u);
+  FlatMesh stretched = settled;
+  for (std::size_t i = 0; i < stretched.Points(); ++i)
+  {
+    double & z = stretched.x[3 * i + 2];
+    z = z > 7.0 ? 7.0 + 2.0 * (z - 7.0) : z;
+  }
+  const FlatMesh input = stretched;
+  FlatMesh       full = stretched;
+  FlatMesh       fresh = stretched;
+  incremental.SetIncremental(true);
+  const auto                  local = incremental.Remesh(stretched.x, stretched.Points(), stretched.triangles);
+  const auto                  all = everywhere.Remesh(full.x, full.Points(), full.triangles);
+  itk::DeformableMeshRemesher forgotten;
+  forgotten.SetTargetEdgeLength(1.5);
+  forgotten.SetIncremental(true);
+  const auto rebuilt = forgotten.Remesh(fresh.x, fresh.Points(), fresh.triangles);
+  EXPECT_GT(local.splits, 10u);
+  EXPECT_EQ(all.relaxed, rebuilt.relaxed) << "a table built from the input: the whole mesh";
+  EXPECT_EQ(full.x, fresh.x);
+  EXPECT_LT(2 * local.relaxed, all.relaxed);
+
+  // Points far below the cap: where they were (incremental), moved (not).
+  const auto farPointsMoved = [&](const FlatMesh & output, const itk::DeformableMeshRemesher & remesher) {
+    std::size_t far = 0;
+    std::size_t moved = 0;
+    for (std::size_t v = 0; v < output.Points(); ++v)
+    {
+      const IndexType p = remesher.Parents()[v];
+      const double *  q = input.x.data() + 3 * p;
+      const bool      nearLastOperations =
+        std::any_of(operatedAt.begin(), operatedAt.end(), [q](const std::array<double, 3> & o) {
+          return (q[0] - o[0]) * (q[0] - o[0]) + (q[1] - o[1]) * (q[1] - o[1]) + (q[2] - o[2]) * (q[2] - o[2]) < 36.0;
+        });
+      if (q[2] < -1.0 && !nearLastOperations)
+      {
+        ++far;
+        moved += output.x[3 * v] != input.x[3 * p] || output.x[3 * v + 1] != input.x[3 * p + 1] ||
+                     output.x[3 * v + 2] != input.x[3 * p + 2]
+                   ? 1
+                   : 0;
+      }
+    }
+    EXPECT_GT(far, output.Points() / 4);
+    std::cout << far << " far points of " << output.Points() << ", " << moved << " moved" << std::endl;
+    return static_cast<double>(moved) / static_cast<double>(far);
+  };
+  EXPECT_EQ(farPointsMoved(stretched, incremental), 0.0);
+  EXPECT_GT(farPointsMoved(full, everywhere), 0.9);
+  // Where it did operate, the incremental remeshing reports which points'
+  // triangles changed: only points near the cap.
+  for (std::size_t v = 0; v < stretched.Points(); ++v)
+  {
+    if (incremental.OutputPointChanged(static_cast<IndexType>(v)))
+    {
+      EXPECT_GT(stretched.x[3 * v + 2], 2.0) << v;
+    }
+  }
+  for (const FlatMesh * m : { &stretched, &full })
+  {
+    const Topology t = Analyse(*m);
+    EXPECT_EQ(t.badEdges + t.boundaryEdges + t.degenerate, 0u);
+    EXPECT_EQ(t.Euler(), 2);
+    double shortest = 0.0;
+    double longest = 0.0;
+    EdgeLengthRange(*m, shortest, longest);
+    EXPECT_LE(longest, incremental.GetMaximumEdgeLength());
+    EXPECT_GE(shortest, 0.5 * incremental.GetMaximumEdgeLength());
+    EXPECT_GE(SmallestAngle(*m), 20.0);
+  }
+  EXPECT_TRUE(incremental.IsOutputClosed());
+}
+
 TEST(DeformableMeshRemesher, PartsGiveOneMeshWhateverTheThreadsAndAValidOne)
 {
   // A sphere of 10 242 points numbered for locality, stretched along z
@@ -895,6 +1007,7 @@ TEST(DeformableMeshRemeshing, StatisticsAreThoseOfTheRemesherOnTheSameMesh)
   FlatMesh                    input = ToFlat(c.sphere);
   itk::DeformableMeshRemesher remesher;
   remesher.SetTargetEdgeLength(target);
+  remesher.SetIncremental(true); // as the filter's
   const itk::DeformableMeshRemesher::Statistics expected = remesher.Remesh(input.x, input.Points(), input.triangles);
   const auto &                                  statistics = filter->GetRemeshingStatistics();
   EXPECT_GT(expected.splits, 1000u);
