@@ -597,6 +597,7 @@ RunRemeshing(benchmark::State & state, bool collisions)
   {
     state.counters["collisions"] = static_cast<double>(model->GetTotalNumberOfCollisionsPrevented());
     state.counters["certified"] = static_cast<double>(model->GetNumberOfCertifiedSteps());
+    state.counters["carried"] = static_cast<double>(model->GetNumberOfCarriedCertificates());
     state.counters["index_builds"] = static_cast<double>(model->GetNumberOfCollisionIndexRebuilds());
   }
   state.counters["vertex_it/s"] =

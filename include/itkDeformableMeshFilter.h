@@ -588,6 +588,14 @@ public:
   {
     return m_Collision.GetTotalNumberOfCertifiedSteps();
   }
+  /** Of those, the steps certified by the margin carried from an earlier
+   * certificate (SurfaceCollision::CarryCertificate()): a pass over the
+   * points instead of the certificate's passes. */
+  SizeValueType
+  GetNumberOfCarriedCertificates() const
+  {
+    return m_Collision.GetTotalNumberOfCarriedCertificates();
+  }
   SizeValueType
   GetNumberOfCollisionIndexRebuilds() const
   {
@@ -629,7 +637,12 @@ public:
   /** Target edge length of the adaptive remeshing, physical units (mm):
    * every RemeshingInterval iterations the edges are brought into
    * [4/5, 4/3] times this length. 0 turns remeshing off: the mesh keeps the
-   * input's points and cells. Must be finite and non-negative. Default: 0. */
+   * input's points and cells. Must be finite and non-negative. Default: 0.
+   * The first remeshing after a reset flips and relaxes the whole mesh; the
+   * later ones, incrementally (DeformableMeshRemesher::SetIncremental()),
+   * only around the points whose triangles the remeshings changed: between
+   * two remeshings, the internal forces keep the points spread along the
+   * surface elsewhere. */
   itkSetMacro(RemeshingEdgeLength, double);
   itkGetConstMacro(RemeshingEdgeLength, double);
 

@@ -1262,6 +1262,17 @@ struct ParallelBlocks
  * surface that is not star-shaped pays for it on at most one step in 64.
  * SetUseStarShapedCertificate(false) turns it off.
  *
+ * A certificate carries to nearby positions: from the orientation
+ * determinants and the points' distances to the centre, each point gets a
+ * margin (CarryCertificate(): a bound of how much the determinants can
+ * change when the points of a triangle move by at most that much), and
+ * positions with every point within its margin of the certified ones are
+ * star-shaped from the same centre: a pass over the points instead of the
+ * certificate's passes, until a point leaves its margin (then the
+ * certificate is computed again, with new margins) or the surface changes
+ * (SetSurface()). The margins are about a fifth of the edge length on a
+ * regular sphere; a surface that settles moves within them for many steps.
+ *
  * The certificate also takes a surface that is star-shaped but for a few
  * folds (IsStarShapedUpToFolds()), as a remeshing or a step leaves on a
  * surface of fine triangles: at most MaximumFoldTriangles triangles face
@@ -1412,6 +1423,7 @@ public:
     m_Closed = closed;
     m_CertificateWait = 0;
     m_CertificateBackoff = 0;
+    m_CarriedMargin = 0.0;
     m_HasSurface = true;
     this->Invalidate();
   }
@@ -1541,6 +1553,30 @@ public:
   GetTotalNumberOfCertifiedSteps() const
   {
     return m_TotalNumberOfCertifiedSteps;
+  }
+  /** Of those, the steps certified by the margin carried from an earlier
+   * certificate (CarryCertificate()), without the passes of the
+   * certificate: a pass over the points. */
+  SizeValueType
+  GetTotalNumberOfCarriedCertificates() const
+  {
+    return m_TotalNumberOfCarriedCertificates;
+  }
+  /** The least of the margins carried from the last certificate without
+   * folds (0 when none), and the margin of \a point: positions with every
+   * point within its margin of the certified ones are certified without the
+   * certificate's passes (CarryCertificate()). */
+  double
+  GetCarriedMargin() const
+  {
+    return m_CarriedMargin;
+  }
+  double
+  GetCarriedMargin(SizeValueType point) const
+  {
+    return m_CarriedMargin > 0.0 && point < m_CarriedLimit.size()
+             ? std::sqrt(static_cast<double>(m_CarriedLimit[point]))
+             : 0.0;
   }
 
   /** Triangles whose candidate pairs the last Constrain() looked at (their
@@ -2904,17 +2940,32 @@ private:
     {
       return false;
     }
+    if (m_CarriedMargin > 0.0 && this->WithinCarriedMargin(y, parallel))
+    {
+      ++m_NumberOfCertifiedSteps;
+      ++m_TotalNumberOfCertifiedSteps;
+      ++m_TotalNumberOfCarriedCertificates;
+      m_IndexValid = false;
+      return true;
+    }
+    m_CarriedMargin = 0.0;
     if (m_CertificateWait > 0)
     {
       --m_CertificateWait;
       return false;
     }
-    if (this->StarShapedUpToFolds(y, parallel))
+    StarSummary pure;
+    pure.undecided = true;
+    if (this->StarShapedUpToFolds(y, parallel, &pure))
     {
       m_CertificateBackoff = 0;
       ++m_NumberOfCertifiedSteps;
       ++m_TotalNumberOfCertifiedSteps;
       m_IndexValid = false;
+      if (!pure.undecided)
+      {
+        this->CarryCertificate(y, pure, parallel);
+      }
       return true;
     }
     m_CertificateBackoff = std::min<unsigned int>(64, std::max<unsigned int>(1, 2 * m_CertificateBackoff));
@@ -2936,6 +2987,132 @@ private:
     double        centre[3]{ 0.0, 0.0, 0.0 };
     double        sharedBound{ 0.0 }; // StarOrientation()'s bound
   };
+
+  /** The star-shaped certificate carried to nearby positions. With centre
+   * o fixed, write A = a - o, B = b - o, C = c - o for a triangle's points
+   * at the certified positions x0, whose orientation determinant
+   * D = A . (B x C) has the sign s of all the others. Moving every point by
+   * at most e changes D by at most e S1 + e^2 S2 + e^3, where
+   * S1 = |B x C| + |C x A| + |A x B| and S2 = |A| + |B| + |C| (the
+   * determinant is linear in each argument, and |det(u, v, w)| is at most
+   * |u| |v| |w|). With d = s D - r (r: StarShaped()'s bound of the
+   * rounding of D) and c = d / S1, which no root of that bound exceeds,
+   * s D stays positive while every point of the triangle moves by at most
+   * f = d / (S1 + c S2 + c^2) (then e S1 + e^2 S2 + e^3 <=
+   * e (S1 + c S2 + c^2) <= d; S1 and S2 are taken from above by
+   * (3 sum of squares)^1/2, which is S1 for three equal cross products, as
+   * on a regular mesh far from the centre). A point's margin is the least f
+   * of its triangles. Positions y with every point within its margin of x0
+   * are joined to x0 by the straight path along which no triangle's
+   * orientation vanishes: the surface never passes through o, the degree of
+   * the central projection stays 1 and every triangle keeps its
+   * orientation, so y is star-shaped from o as x0 is (class
+   * documentation). Computed after a certificate that needed no fold (a
+   * pass over the triangles, in parallel, and one over their corners), with
+   * a copy of x0. */
+  template <typename TParallel>
+  void
+  CarryCertificate(const double * x, const StarSummary & summary, TParallel && parallel)
+  {
+    using SurfaceCollisionDetail::Dot;
+    const SizeValueType     numberOfTriangles = this->GetNumberOfTriangles();
+    const double            sign = summary.positive > 0 ? 1.0 : -1.0;
+    const double *          o = summary.centre;
+    const double            rounding = summary.sharedBound;
+    constexpr SizeValueType block = SurfaceCollisionDetail::ParallelBlocks::Block;
+    // Per triangle, f = d / (S1 + c S2 + c^2), as a float rounded down.
+    std::vector<float> & bound = m_CarriedTriangleBound;
+    bound.resize(numberOfTriangles);
+    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+      for (SizeValueType t = begin; t < end; ++t)
+      {
+        const IndexType * vt = m_Triangles.data() + 3 * t;
+        double            a[3];
+        double            b[3];
+        double            c[3];
+        SurfaceCollisionDetail::Subtract(x + 3 * static_cast<SizeValueType>(vt[0]), o, a);
+        SurfaceCollisionDetail::Subtract(x + 3 * static_cast<SizeValueType>(vt[1]), o, b);
+        SurfaceCollisionDetail::Subtract(x + 3 * static_cast<SizeValueType>(vt[2]), o, c);
+        const double bc[3] = { b[1] * c[2] - b[2] * c[1], b[2] * c[0] - b[0] * c[2], b[0] * c[1] - b[1] * c[0] };
+        const double ca[3] = { c[1] * a[2] - c[2] * a[1], c[2] * a[0] - c[0] * a[2], c[0] * a[1] - c[1] * a[0] };
+        const double ab[3] = { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
+        const double d = sign * Dot(a, bc) - rounding;
+        const double s1 = std::sqrt(3.0 * (Dot(bc, bc) + Dot(ca, ca) + Dot(ab, ab)));
+        const double s2 = std::sqrt(3.0 * (Dot(a, a) + Dot(b, b) + Dot(c, c)));
+        const double positive = d > 0.0 ? d : 0.0; // NaN: 0
+        const double cap = positive / s1;
+        // Less a millionth: the rounding of S1, S2 and of the quotients.
+        const double f = (1.0 - 1e-6) * positive / (s1 + cap * s2 + cap * cap);
+        auto         rounded = static_cast<float>(f);
+        if (static_cast<double>(rounded) > f)
+        {
+          rounded = std::nextafter(rounded, 0.0f);
+        }
+        bound[t] = f > 0.0 ? rounded : 0.0f; // NaN: 0
+      }
+    });
+    // Per point, the least bound of its triangles, squared (rounded down).
+    std::vector<float> & limit = m_CarriedLimit;
+    limit.assign(m_NumberOfPoints, std::numeric_limits<float>::infinity());
+    for (SizeValueType t = 0; t < numberOfTriangles; ++t)
+    {
+      const IndexType * vt = m_Triangles.data() + 3 * t;
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        limit[vt[k]] = std::min(limit[vt[k]], bound[t]);
+      }
+    }
+    float least = std::numeric_limits<float>::infinity();
+    for (float & l : limit)
+    {
+      const double square = static_cast<double>(l) * static_cast<double>(l) * (1.0 - 1e-6);
+      l = static_cast<float>(square);
+      if (static_cast<double>(l) > square)
+      {
+        l = std::nextafter(l, 0.0f);
+      }
+      least = std::min(least, l);
+    }
+    if (!(least > 0.0f && std::isfinite(least)))
+    {
+      m_CarriedMargin = 0.0;
+      return;
+    }
+    m_CarriedFrom.assign(x, x + 3 * m_NumberOfPoints);
+    m_CarriedMargin = std::sqrt(static_cast<double>(least));
+  }
+
+  /** Whether every point of \a y lies within its carried margin of its
+   * position where the certificate was last computed (CarryCertificate()).
+   * A pass over the points. */
+  template <typename TParallel>
+  bool
+  WithinCarriedMargin(const double * y, TParallel && parallel) const
+  {
+    const SizeValueType n = m_NumberOfPoints;
+    if (m_CarriedFrom.size() != 3 * n)
+    {
+      return false;
+    }
+    // The squared margins have a millionth less, for the rounding of the
+    // squares here.
+    const float *           limit = m_CarriedLimit.data();
+    const double *          x0 = m_CarriedFrom.data();
+    constexpr SizeValueType block = SurfaceCollisionDetail::ParallelBlocks::Block;
+    std::vector<uint8_t>    outside((n + block - 1) / block, 0);
+    parallel(n, [&](SizeValueType begin, SizeValueType end) {
+      bool far = false;
+      for (SizeValueType i = begin; i < end; ++i)
+      {
+        const double dx = y[3 * i] - x0[3 * i];
+        const double dy = y[3 * i + 1] - x0[3 * i + 1];
+        const double dz = y[3 * i + 2] - x0[3 * i + 2];
+        far = far || !(dx * dx + dy * dy + dz * dz <= static_cast<double>(limit[i])); // NaN: far
+      }
+      outside[begin / block] = far ? 1 : 0;
+    });
+    return std::find(outside.begin(), outside.end(), uint8_t{ 1 }) == outside.end();
+  }
 
   /** IsStarShaped(), with the passes run by \a parallel; what it found in
    * \a summary when not null. */
@@ -3102,12 +3279,16 @@ private:
    * so no other pair can meet. False when in doubt. */
   template <typename TParallel>
   bool
-  StarShapedUpToFolds(const double * x, TParallel && parallel) const
+  StarShapedUpToFolds(const double * x, TParallel && parallel, StarSummary * pure = nullptr) const
   {
     using SurfaceCollisionDetail::Dot;
     StarSummary summary;
     if (this->StarShaped(x, parallel, &summary))
     {
+      if (pure != nullptr)
+      {
+        *pure = summary;
+      }
       return true;
     }
     const int           majority = summary.positive >= summary.negative ? 1 : -1;
@@ -4450,6 +4631,13 @@ private:
   SizeValueType m_TotalNumberOfCertifiedSteps{ 0 };
   unsigned int  m_CertificateWait{ 0 };    // calls to skip before the next try
   unsigned int  m_CertificateBackoff{ 0 }; // the last wait
+  // CarryCertificate(): the positions of the last certificate without
+  // folds, and how far every point may move from them (0: no carrying).
+  std::vector<double> m_CarriedFrom;
+  std::vector<float>  m_CarriedTriangleBound; // per triangle (scratch)
+  std::vector<float>  m_CarriedLimit;         // per point, its margin squared
+  double              m_CarriedMargin{ 0.0 }; // the least margin
+  SizeValueType       m_TotalNumberOfCarriedCertificates{ 0 };
 
   // The index (see the class documentation).
   bool                            m_IndexValid{ false };

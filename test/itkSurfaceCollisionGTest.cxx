@@ -987,6 +987,157 @@ CountFoldedFans(const std::vector<double> & x, const std::vector<uint32_t> & tri
 }
 } // namespace
 
+TEST(SurfaceCollision, TheCertificateCarriesToPositionsWithinItsMargin)
+{
+  // A certificate without folds carries a margin: positions with every
+  // point within it of the certified ones are star-shaped from the same
+  // centre, and are accepted by a pass over the points.
+  std::vector<double>   x;
+  std::vector<uint32_t> triangles;
+  StarSphere(x, triangles);
+  const std::size_t     n = x.size() / 3;
+  const std::size_t     numberOfTriangles = triangles.size() / 3;
+  itk::SurfaceCollision collision;
+  collision.SetSurface(n, triangles.data(), numberOfTriangles);
+  std::vector<double> y = x;
+  EXPECT_EQ(collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1).constrained, 0u);
+  EXPECT_EQ(collision.GetTotalNumberOfCertifiedSteps(), 1u);
+  EXPECT_EQ(collision.GetTotalNumberOfCarriedCertificates(), 0u);
+  const double margin = collision.GetCarriedMargin();
+
+  // The centre of the certificate: the centroid of the points.
+  double centre[3] = { 0.0, 0.0, 0.0 };
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    for (unsigned int d = 0; d < 3; ++d)
+    {
+      centre[d] += x[3 * i + d] / static_cast<double>(n);
+    }
+  }
+  // Bounds: above, the least distance from the centre to a triangle's plane
+  // (moving a triangle's points that far toward the centre puts the centre
+  // on it); below, not vanishing on this regular sphere (about a fifth of
+  // its edge length, 1.1, here). Twice the margin fails the test of the
+  // steepest motions below.
+  const auto sub = [](const double * p, const double * q, long double * r) {
+    for (unsigned int d = 0; d < 3; ++d)
+    {
+      r[d] = static_cast<long double>(p[d]) - static_cast<long double>(q[d]);
+    }
+  };
+  const auto cross = [](const long double * u, const long double * v, long double * w) {
+    w[0] = u[1] * v[2] - u[2] * v[1];
+    w[1] = u[2] * v[0] - u[0] * v[2];
+    w[2] = u[0] * v[1] - u[1] * v[0];
+  };
+  const auto dot = [](const long double * u, const long double * v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; };
+  long double nearestPlane = std::numeric_limits<long double>::infinity();
+  for (std::size_t t = 0; t < numberOfTriangles; ++t)
+  {
+    long double a[3], b[3], c[3], ab[3], ac[3], normal[3];
+    sub(&x[3 * triangles[3 * t]], centre, a);
+    sub(&x[3 * triangles[3 * t + 1]], centre, b);
+    sub(&x[3 * triangles[3 * t + 2]], centre, c);
+    for (unsigned int d = 0; d < 3; ++d)
+    {
+      ab[d] = b[d] - a[d];
+      ac[d] = c[d] - a[d];
+    }
+    cross(ab, ac, normal);
+    nearestPlane = std::min(nearestPlane, std::abs(dot(a, normal)) / std::sqrt(dot(normal, normal)));
+  }
+  EXPECT_LT(margin, static_cast<double>(nearestPlane));
+  EXPECT_GT(margin, 0.15);
+  std::cout << "margin " << margin << ", nearest plane " << static_cast<double>(nearestPlane) << std::endl;
+
+  // For each triangle, its points moved each by its own margin (at least
+  // the least one) in the directions that shrink the triangle's orientation
+  // determinant fastest (against the gradient: B x C for A, ...): every
+  // orientation keeps its sign (long double).
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    ASSERT_GE(collision.GetCarriedMargin(i), margin);
+  }
+  for (std::size_t t = 0; t < numberOfTriangles; ++t)
+  {
+    long double p[3][3];
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      sub(&x[3 * triangles[3 * t + k]], centre, p[k]);
+    }
+    long double gradient[3][3];
+    cross(p[1], p[2], gradient[0]);
+    cross(p[2], p[0], gradient[1]);
+    cross(p[0], p[1], gradient[2]);
+    const long double before = dot(p[0], gradient[0]);
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      const long double length = std::sqrt(dot(gradient[k], gradient[k]));
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        p[k][d] -= (before > 0 ? 1 : -1) * static_cast<long double>(collision.GetCarriedMargin(triangles[3 * t + k])) *
+                   gradient[k][d] / length;
+      }
+    }
+    long double bc[3];
+    cross(p[1], p[2], bc);
+    ASSERT_GT(before * dot(p[0], bc), 0.0L) << "triangle " << t;
+  }
+
+  // Random displacements of length 0.999 margin: certified by the margin
+  // (no new certificate), and star-shaped, free of intersecting pairs, as
+  // the exact certificate and the test of all pairs find.
+  std::mt19937                     random(7);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial)
+  {
+    y = x;
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      double       v[3] = { normal(random), normal(random), normal(random) };
+      const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        y[3 * i + d] += 0.999 * margin * v[d] / length;
+      }
+    }
+    const std::vector<double> proposed = y;
+    EXPECT_EQ(collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1).constrained, 0u);
+    EXPECT_EQ(y, proposed);
+    EXPECT_EQ(collision.GetTotalNumberOfCarriedCertificates(), static_cast<std::size_t>(trial + 1));
+    itk::SurfaceCollision fresh;
+    fresh.SetSurface(n, triangles.data(), numberOfTriangles);
+    EXPECT_TRUE(fresh.IsStarShaped(y.data()));
+    EXPECT_EQ(CheckAllPairs(y, triangles, 0.0).intersecting, 0u);
+  }
+  // One point moved by twice its margin: the certificate again (new
+  // margins, from these positions), not the carried one.
+  y = x;
+  y[0] += 2.0 * collision.GetCarriedMargin(0);
+  const std::size_t carried = collision.GetTotalNumberOfCarriedCertificates();
+  const std::size_t certified = collision.GetTotalNumberOfCertifiedSteps();
+  EXPECT_EQ(collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1).constrained, 0u);
+  EXPECT_EQ(collision.GetTotalNumberOfCarriedCertificates(), carried);
+  EXPECT_EQ(collision.GetTotalNumberOfCertifiedSteps(), certified + 1);
+  EXPECT_GT(collision.GetCarriedMargin(), 0.0);
+  // A new surface (SetSurface()) carries nothing; nor does a minimum
+  // distance above 0 use the certificate.
+  collision.SetSurface(n, triangles.data(), numberOfTriangles);
+  EXPECT_EQ(collision.GetCarriedMargin(), 0.0);
+  y = x;
+  collision.Constrain(x.data(), y.data(), 0.1, nullptr, 1);
+  EXPECT_EQ(collision.GetTotalNumberOfCertifiedSteps(), certified + 1);
+  // Pushed through the sphere: neither the margin nor the certificate takes
+  // it, the index stops the point.
+  y = x;
+  collision.SetSurface(n, triangles.data(), numberOfTriangles);
+  EXPECT_EQ(collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1).constrained, 0u);
+  ASSERT_GT(collision.GetCarriedMargin(), 0.0);
+  std::vector<double> through = PushedThrough(x);
+  EXPECT_GT(collision.Constrain(x.data(), through.data(), 0.0, nullptr, 1).constrained, 0u);
+  EXPECT_EQ(CheckAllPairs(through, triangles, 0.0).intersecting, 0u);
+}
+
 TEST(SurfaceCollision, TheCertificateTakesFoldsThatMeetNothing)
 {
   std::vector<double>   x;
