@@ -1782,19 +1782,27 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
       nullptr);
     // The remeshed triangles marked 2, as triples of their points' parents,
     // looked up among the input's triangles in one pass over them (those all
-    // of whose points are parents of a candidate's).
-    candidates.clear();
-    for (SizeValueType b = 0; b < triangleBlocks; ++b)
-    {
-      for (SizeValueType t = b * block; blockUnmoved[b] != 0 && t < std::min(remeshedTriangles, (b + 1) * block); ++t)
-      {
-        if (changed[t] == 2)
+    // of whose points are parents of a candidate's); both in parallel.
+    std::vector<std::vector<std::pair<Triple, SizeValueType>>> blockCandidates(triangleBlocks);
+    threader->ParallelizeArray(
+      0,
+      triangleBlocks,
+      [&](SizeValueType b) {
+        for (SizeValueType t = b * block; blockUnmoved[b] != 0 && t < std::min(remeshedTriangles, (b + 1) * block); ++t)
         {
-          const IndexType32 * v = m_Triangles.data() + 3 * t;
-          candidates.emplace_back(sorted(parents[v[0]], parents[v[1]], parents[v[2]]), t);
-          changed[t] = 1;
+          if (changed[t] == 2)
+          {
+            const IndexType32 * v = m_Triangles.data() + 3 * t;
+            blockCandidates[b].emplace_back(sorted(parents[v[0]], parents[v[1]], parents[v[2]]), t);
+            changed[t] = 1;
+          }
         }
-      }
+      },
+      nullptr);
+    candidates.clear();
+    for (const auto & found : blockCandidates)
+    {
+      candidates.insert(candidates.end(), found.begin(), found.end());
     }
     if (!candidates.empty())
     {
@@ -1807,19 +1815,37 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
           candidatePoint[p] = 1;
         }
       }
-      for (SizeValueType t = 0; t < beforeTriangles.size() / 3; ++t)
+      const SizeValueType                     inputTriangles = beforeTriangles.size() / 3;
+      const SizeValueType                     inputBlocks = (inputTriangles + block - 1) / block;
+      std::vector<std::vector<SizeValueType>> matched(inputBlocks);
+      threader->ParallelizeArray(
+        0,
+        inputBlocks,
+        [&](SizeValueType b) {
+          for (SizeValueType t = b * block; t < std::min(inputTriangles, (b + 1) * block); ++t)
+          {
+            const IndexType32 * v = beforeTriangles.data() + 3 * t;
+            if ((candidatePoint[v[0]] & candidatePoint[v[1]] & candidatePoint[v[2]]) == 0)
+            {
+              continue;
+            }
+            const Triple triple = sorted(v[0], v[1], v[2]);
+            auto         it =
+              std::lower_bound(candidates.begin(), candidates.end(), triple, [](const auto & c, const Triple & k) {
+                return c.first < k;
+              });
+            for (; it != candidates.end() && it->first == triple; ++it)
+            {
+              matched[b].push_back(it->second);
+            }
+          }
+        },
+        nullptr);
+      for (const auto & found : matched)
       {
-        const IndexType32 * v = beforeTriangles.data() + 3 * t;
-        if ((candidatePoint[v[0]] & candidatePoint[v[1]] & candidatePoint[v[2]]) == 0)
+        for (const SizeValueType t : found)
         {
-          continue;
-        }
-        const Triple triple = sorted(v[0], v[1], v[2]);
-        auto         it = std::lower_bound(
-          candidates.begin(), candidates.end(), triple, [](const auto & c, const Triple & k) { return c.first < k; });
-        for (; it != candidates.end() && it->first == triple; ++it)
-        {
-          changed[it->second] = 0; // the input's triangle, its points unmoved
+          changed[t] = 0; // the input's triangle, its points unmoved
         }
       }
     }
