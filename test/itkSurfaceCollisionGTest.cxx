@@ -36,6 +36,7 @@
 #include <cmath>
 #include <map>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace
@@ -1050,14 +1051,9 @@ TEST(SurfaceCollision, TheCertificateCarriesToPositionsWithinItsMargin)
   EXPECT_GT(margin, 0.15);
   std::cout << "margin " << margin << ", nearest plane " << static_cast<double>(nearestPlane) << std::endl;
 
-  // For each triangle, its points moved each by its own margin (at least
-  // the least one) in the directions that shrink the triangle's orientation
-  // determinant fastest (against the gradient: B x C for A, ...): every
-  // orientation keeps its sign (long double).
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    ASSERT_GE(collision.GetCarriedMargin(i), margin);
-  }
+  // For each triangle, its points moved by the margin in the directions
+  // that shrink its orientation determinant fastest (against the gradient:
+  // B x C for A, ...): every orientation keeps its sign (long double).
   for (std::size_t t = 0; t < numberOfTriangles; ++t)
   {
     long double p[3][3];
@@ -1075,8 +1071,7 @@ TEST(SurfaceCollision, TheCertificateCarriesToPositionsWithinItsMargin)
       const long double length = std::sqrt(dot(gradient[k], gradient[k]));
       for (unsigned int d = 0; d < 3; ++d)
       {
-        p[k][d] -= (before > 0 ? 1 : -1) * static_cast<long double>(collision.GetCarriedMargin(triangles[3 * t + k])) *
-                   gradient[k][d] / length;
+        p[k][d] -= (before > 0 ? 1 : -1) * static_cast<long double>(margin) * gradient[k][d] / length;
       }
     }
     long double bc[3];
@@ -1110,10 +1105,10 @@ TEST(SurfaceCollision, TheCertificateCarriesToPositionsWithinItsMargin)
     EXPECT_TRUE(fresh.IsStarShaped(y.data()));
     EXPECT_EQ(CheckAllPairs(y, triangles, 0.0).intersecting, 0u);
   }
-  // One point moved by twice its margin: the certificate again (new
-  // margins, from these positions), not the carried one.
+  // One point moved by twice the margin: the certificate again (a new
+  // margin, from these positions), not the carried one.
   y = x;
-  y[0] += 2.0 * collision.GetCarriedMargin(0);
+  y[0] += 2.0 * margin;
   const std::size_t carried = collision.GetTotalNumberOfCarriedCertificates();
   const std::size_t certified = collision.GetTotalNumberOfCertifiedSteps();
   EXPECT_EQ(collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1).constrained, 0u);
@@ -1130,12 +1125,36 @@ TEST(SurfaceCollision, TheCertificateCarriesToPositionsWithinItsMargin)
   // Pushed through the sphere: neither the margin nor the certificate takes
   // it, the index stops the point.
   y = x;
-  collision.SetSurface(n, triangles.data(), numberOfTriangles);
-  EXPECT_EQ(collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1).constrained, 0u);
-  ASSERT_GT(collision.GetCarriedMargin(), 0.0);
+  itk::SurfaceCollision pushed;
+  pushed.SetSurface(n, triangles.data(), numberOfTriangles);
+  EXPECT_EQ(pushed.Constrain(x.data(), y.data(), 0.0, nullptr, 1).constrained, 0u);
+  ASSERT_GT(pushed.GetCarriedMargin(), 0.0);
   std::vector<double> through = PushedThrough(x);
-  EXPECT_GT(collision.Constrain(x.data(), through.data(), 0.0, nullptr, 1).constrained, 0u);
+  EXPECT_GT(pushed.Constrain(x.data(), through.data(), 0.0, nullptr, 1).constrained, 0u);
   EXPECT_EQ(CheckAllPairs(through, triangles, 0.0).intersecting, 0u);
+
+  // Margins that do not last: point 0 goes out by three margins and back at
+  // every step, so that no step is carried. A margin is computed after the
+  // first certificate, then after waits of 1, 2 and 4 certificates.
+  itk::SurfaceCollision jumpy;
+  jumpy.SetSurface(n, triangles.data(), numberOfTriangles);
+  std::string computed;
+  for (int step = 0; step < 12; ++step)
+  {
+    y = x;
+    if (step % 2 == 1)
+    {
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        y[d] += 3.0 * margin * (x[d] - centre[d]) / 5.0;
+      }
+    }
+    EXPECT_EQ(jumpy.Constrain(x.data(), y.data(), 0.0, nullptr, 1).constrained, 0u);
+    computed += jumpy.GetCarriedMargin() > 0.0 ? 'Y' : 'N';
+  }
+  EXPECT_EQ(jumpy.GetTotalNumberOfCertifiedSteps(), 12u);
+  EXPECT_EQ(jumpy.GetTotalNumberOfCarriedCertificates(), 0u);
+  EXPECT_EQ(computed, "YNYNNYNNNNYN");
 }
 
 TEST(SurfaceCollision, TheCertificateTakesFoldsThatMeetNothing)
