@@ -3060,9 +3060,12 @@ private:
         SurfaceCollisionDetail::Subtract(x + 3 * static_cast<SizeValueType>(vt[0]), o, a);
         SurfaceCollisionDetail::Subtract(x + 3 * static_cast<SizeValueType>(vt[1]), o, b);
         SurfaceCollisionDetail::Subtract(x + 3 * static_cast<SizeValueType>(vt[2]), o, c);
-        const double bc[3] = { b[1] * c[2] - b[2] * c[1], b[2] * c[0] - b[0] * c[2], b[0] * c[1] - b[1] * c[0] };
-        const double ca[3] = { c[1] * a[2] - c[2] * a[1], c[2] * a[0] - c[0] * a[2], c[0] * a[1] - c[1] * a[0] };
-        const double ab[3] = { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
+        double bc[3];
+        double ca[3];
+        double ab[3];
+        SurfaceCollisionDetail::Cross(b, c, bc);
+        SurfaceCollisionDetail::Cross(c, a, ca);
+        SurfaceCollisionDetail::Cross(a, b, ab);
         const double d = sign * Dot(a, bc) - rounding;
         const double s1Squared = 3.0 * (Dot(bc, bc) + Dot(ca, ca) + Dot(ab, ab));
         const double s2Squared = 3.0 * (Dot(a, a) + Dot(b, b) + Dot(c, c));

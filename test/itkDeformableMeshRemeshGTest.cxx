@@ -457,7 +457,8 @@ TEST(DeformableMeshRemesher, KeptTableGivesTheSameMeshAsAFreshOne)
 
 TEST(DeformableMeshRemesher, IncrementalRemeshingMovesNothingFarFromItsOperations)
 {
-  // A sphere remeshed until a round makes no operation, then a cap (z > 7)
+  // A sphere remeshed 30 rounds, after which a round makes a few operations
+  // (a cycle of a split, a collapse and a flip), then a cap (z > 7)
   // stretched along z to twice its height: its edges leave the band.
   // Incremental, the next Remesh() of that mesh (the same triangles: the
   // table is kept) splits the cap's edges and flips and relaxes around its
