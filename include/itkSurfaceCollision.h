@@ -3038,7 +3038,12 @@ private:
   CarryCertificate(const double * x, const StarSummary & summary, TParallel && parallel)
   {
     using SurfaceCollisionDetail::Dot;
-    const SizeValueType     numberOfTriangles = this->GetNumberOfTriangles();
+    const SizeValueType numberOfTriangles = this->GetNumberOfTriangles();
+    m_CarriedMargin = 0.0;
+    if (numberOfTriangles == 0)
+    {
+      return;
+    }
     const double            sign = summary.positive > 0 ? 1.0 : -1.0;
     const double *          o = summary.centre;
     const double            rounding = summary.sharedBound;
@@ -3092,7 +3097,6 @@ private:
     const double margin = (1.0 - 1e-6) * *std::min_element(least.begin(), least.end());
     if (!(margin > 0.0 && std::isfinite(margin)))
     {
-      m_CarriedMargin = 0.0;
       return;
     }
     m_CarriedFrom.assign(x, x + 3 * m_NumberOfPoints);
