@@ -1736,8 +1736,8 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
     // points did. A triangle whose points did not move and around none of
     // which the remesher changed the triangles is the input's (0); 2: its
     // points did not move but one's triangles changed, the input's
-    // triangles decide, below and in order, in the blocks that have such
-    // triangles.
+    // triangles decide, below, for the blocks that have such triangles
+    // (blockUnmoved).
     const SizeValueType     remeshedPoints = parents.size();
     constexpr SizeValueType block = 16384;
     MultiThreaderBase *     threader = this->GetMultiThreader();
