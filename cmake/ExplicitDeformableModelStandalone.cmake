@@ -16,7 +16,12 @@ include(${ITK_USE_FILE})
 
 include(cmake/ExplicitDeformableModelParts.cmake)
 
-if(BUILD_TESTING)
+# The core's GoogleTests and their kernel-path reruns depend on neither VTK
+# nor ParaView: a second configuration of the same sources against another
+# VTK (CI's ParaView stage) may leave them to the first.
+option(EDM_BUILD_CORE_TESTS "Build and register the core's GoogleTests (test/)" ON)
+mark_as_advanced(EDM_BUILD_CORE_TESTS)
+if(BUILD_TESTING AND EDM_BUILD_CORE_TESTS)
   add_subdirectory(test)
 endif()
 

@@ -7,7 +7,8 @@
 # packages, installs ParaView 5.11 and the Qt development packages its CMake
 # configuration asks for (paraview-dev does not depend on them), configures a separate build tree with
 # -DBUILD_PARAVIEW_PLUGIN=ON (the VTK module against ParaView's VTK, and the
-# ParaView plugin), builds it and runs its tests, among them the plugin test
+# ParaView plugin; not the core's GoogleTests, which the first stage ran),
+# builds it and runs its tests, among them the plugin test
 # under pvpython and xvfb-run.
 #
 # Usage: scripts/ci-paraview.sh [build directory, default build-paraview]
@@ -44,8 +45,12 @@ apt-get install -y -qq --no-install-recommends \
   xvfb xauth
 installed_at=$(date +%s)
 
-# The benchmarks are the first stage's business.
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DBUILD_PARAVIEW_PLUGIN=ON -DEDM_BUILD_BENCHMARKS=OFF "$@"
+# The benchmarks are the first stage's business, and so are the core's
+# GoogleTests (test/: neither VTK nor ParaView is in them). Without them and
+# their kernel-path reruns this stage runs 189 tests in 106 s instead of 323
+# in 187 s, and builds 11 fewer translation units of ITK templates.
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DBUILD_PARAVIEW_PLUGIN=ON -DEDM_BUILD_BENCHMARKS=OFF \
+  -DEDM_BUILD_CORE_TESTS=OFF "$@"
 cmake --build "$build" -j"$jobs"
 built_at=$(date +%s)
 
