@@ -561,6 +561,13 @@ private:
       }
     }
   }
+  /** Incremental second round: the triangles with a point in m_RelaxSet
+   * and those of the corners in m_LeftShort, as the splits' candidates
+   * (m_SplitTouched) and the collapses' (m_ShortEdgesStale over an empty
+   * m_ShortEdges); false, with nothing queued, when they are more than a
+   * sixteenth of the triangles (a scan of the whole mesh is then cheaper). */
+  bool
+  QueueSecondRound();
   /** Queues the three corners (and their twins) of each triangle of the
    * fan of \a v. */
   void
@@ -613,6 +620,7 @@ private:
   // it visited and left short, and those it changed behind its position.
   // The LengthenPass() right after it starts from these instead of a scan.
   std::vector<IndexType> m_StillShort;
+  std::vector<IndexType> m_LeftShort; // m_StillShort after the first CollapsePass(), incremental
   bool                   m_TrackStillShort{ false };
   bool                   m_StillShortValid{ false };
   std::vector<IndexType> m_NewIndex; // scratch of Compact()
@@ -2078,6 +2086,41 @@ DeformableMeshRemesher::LengthenPass()
   this->RunQueue(SweepInputs::None, body);
 }
 
+inline bool
+DeformableMeshRemesher::QueueSecondRound()
+{
+  m_SplitTouched.clear();
+  const std::size_t numberOfCorners = m_V.size();
+  const std::size_t most = numberOfCorners / 48; // a sixteenth of the triangles
+  // At least two triangles per point of m_RelaxSet (six around a point,
+  // each counted at most three times): too many without listing them.
+  if (2 * static_cast<std::size_t>(std::count(m_RelaxSet.begin(), m_RelaxSet.end(), uint8_t{ 1 })) > most)
+  {
+    return false;
+  }
+  for (std::size_t c = 0; c < numberOfCorners && m_SplitTouched.size() <= most; c += 3)
+  {
+    const IndexType a = m_V[c];
+    if (a != Invalid && (m_RelaxSet[a] | m_RelaxSet[m_V[c + 1]] | m_RelaxSet[m_V[c + 2]]) != 0)
+    {
+      m_SplitTouched.push_back(static_cast<IndexType>(c / 3));
+    }
+  }
+  for (const IndexType c : m_LeftShort)
+  {
+    m_SplitTouched.push_back(c / 3);
+  }
+  if (m_SplitTouched.size() > most)
+  {
+    m_SplitTouched.clear();
+    return false;
+  }
+  m_ShortEdges.assign((numberOfCorners + 63) / 64, 0);
+  m_ShortEdgesStale.assign(m_SplitTouched.begin(), m_SplitTouched.end());
+  m_ShortEdgesValid = true;
+  return true;
+}
+
 inline void
 DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<IndexType> & triangles)
 {
@@ -2347,6 +2390,10 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
   for (unsigned int pass = 0; pass < 16 && this->SplitPass(pass == 0); ++pass)
   {}
   this->CollapsePass();
+  if (m_Local)
+  {
+    m_LeftShort.assign(m_StillShort.begin(), m_StillShort.end());
+  }
   this->FlipPass();
   if (m_Local)
   {
@@ -2374,8 +2421,24 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
   {
     touched &= TouchedNow;
   }
-  for (unsigned int pass = 0; pass < 16 && this->SplitPass(pass == 0); ++pass)
-  {}
+  if (m_Local)
+  {
+    // Since the first round's scan, the first round's operations changed
+    // edges around the points they touched and the relaxation moved only
+    // points of m_RelaxSet, which holds those: the edges that may have left
+    // the band are those of the triangles with a point in m_RelaxSet, and
+    // the short edges the first collapse pass could not remove. The second
+    // round looks at these instead of scanning the whole mesh again, unless
+    // they are so many that the parallel scan costs less.
+    const bool queued = this->QueueSecondRound();
+    for (unsigned int pass = 0; pass < 16 && this->SplitPass(!queued && pass == 0); ++pass)
+    {}
+  }
+  else
+  {
+    for (unsigned int pass = 0; pass < 16 && this->SplitPass(pass == 0); ++pass)
+    {}
+  }
   this->CollapsePass();
   this->LengthenPass();
   this->Compact(coordinates, triangles);
