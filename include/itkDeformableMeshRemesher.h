@@ -185,7 +185,10 @@ public:
    * connectivity changed since the last flip pass: the flip pass the edges
    * with an end-point or an opposite point that an operation (split,
    * collapse, flip) touched, the relaxation those points and their
-   * neighbours. The splits and collapses still test every edge. Elsewhere
+   * neighbours. The first round of splits and collapses tests every edge;
+   * the second (after the relaxation) only the edges of the triangles
+   * around those points and the short edges the first round left, when
+   * these are at most a sixteenth of the triangles. Elsewhere
    * the valences are as the last flip pass left them and the points as the
    * last relaxation left them, moved since by the caller: DeformableMeshFilter,
    * whose internal forces keep the points spread along the surface between
