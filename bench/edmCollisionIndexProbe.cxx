@@ -22,8 +22,9 @@
 // step that keeps the index (best of 200, every coordinate moved by a
 // Gaussian of 0.01 mm, the same displacement each time), in ns of process
 // CPU time per point.
-// Not built by CMake: it is compiled against one header or another to
-// compare two versions of the index (docs/performance.md):
+// Built by CMake (a ctest runs it at resolution 4); to compare two
+// versions of the index (docs/performance.md), compile it against one
+// header or the other:
 //
 //   g++ -O2 -std=c++17 -I<dir of itkSurfaceCollision.h> -Iinclude -I/usr/include/ITK-5.2 \
 //     bench/edmCollisionIndexProbe.cxx -o probe -lITKCommon-5.2 && ./probe 7
