@@ -590,7 +590,9 @@ public:
   }
   /** Of those, the steps certified by the margin carried from an earlier
    * certificate (SurfaceCollision::CarryCertificate()): a pass over the
-   * points instead of the certificate's passes. */
+   * points instead of the certificate's passes, and when a few points have
+   * left the margin, exact signs for the triangles around them
+   * (SurfaceCollision::CarriedTo()). */
   SizeValueType
   GetNumberOfCarriedCertificates() const
   {

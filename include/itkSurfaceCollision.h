@@ -29,6 +29,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <numeric>
 #include <utility>
 #include <vector>
 #if defined(__SSE2__)
@@ -1268,9 +1269,12 @@ struct ParallelBlocks
  * when the points of a triangle move by at most that much), and
  * positions with every point within the margin of the certified ones are
  * star-shaped from the same centre: a pass over the points instead of the
- * certificate's passes, until a point leaves its margin (then the
- * certificate is computed again, with new margins) or the surface changes
- * (SetSurface()). The margins are about a fifth of the edge length on a
+ * certificate's passes. When a few points (at most a 32nd) have left it,
+ * the triangles around them are followed along the straight path from the
+ * certified positions, by 7 exact orientation signs each (CarriedTo()):
+ * the certificate is computed again, with new margins, only when more
+ * points have left, when one of those triangles may turn on the way, or
+ * when the surface changes (SetSurface()). The margins are about a fifth of the edge length on a
  * regular sphere; a surface that settles moves within them for many steps.
  * Where the margins do not last (a surface remeshed every few steps), the
  * margin is computed less often (CarryNow()).
@@ -2934,7 +2938,7 @@ private:
     {
       return false;
     }
-    if (m_CarriedMargin > 0.0 && this->WithinCarriedMargin(y, parallel))
+    if (m_CarriedMargin > 0.0 && this->CarriedTo(y, parallel))
     {
       ++m_NumberOfCertifiedSteps;
       ++m_TotalNumberOfCertifiedSteps;
@@ -3101,14 +3105,30 @@ private:
     }
     m_CarriedFrom.assign(x, x + 3 * m_NumberOfPoints);
     m_CarriedMargin = margin;
+    std::copy(o, o + 3, m_CarriedCentre);
+    m_CarriedSign = sign > 0.0 ? 1 : -1;
   }
 
-  /** Whether every point of \a y lies within the carried margin of its
-   * position where the certificate was last computed (CarryCertificate()).
-   * A pass over the points. */
+  /** Whether \a y is star-shaped from the centre of the carried certificate
+   * (CarryCertificate()), decided without the certificate's passes: a pass
+   * over the points finds those farther than the carried margin from their
+   * certified positions x0. None: y is within the margin (CarryCertificate()).
+   * At most a 32nd of the points: every triangle with such a point must keep
+   * its orientation along the straight path from x0 to y. Along it each
+   * point is (1 - t) p0 + t p1, and the orientation determinant, linear in
+   * each of the triangle's three points, is the sum over the 8 choices of
+   * each point's end of (1 - t) or t to the number of points taken at x0 or
+   * at y, times the determinant of that choice: a mean of the 8 with
+   * non-negative weights. When the 7 that involve y have the sign of the
+   * certified one (exact signs), the orientation never vanishes on the way.
+   * The other triangles keep theirs by the margin, so along the whole path
+   * no triangle passes through the centre: the degree of the central
+   * projection stays 1 and y is star-shaped as x0 is (class documentation).
+   * More points beyond the margin, a sign that differs, or a coordinate that
+   * is not finite: false (the certificate is computed again). */
   template <typename TParallel>
   bool
-  WithinCarriedMargin(const double * y, TParallel && parallel) const
+  CarriedTo(const double * y, TParallel && parallel)
   {
     const SizeValueType n = m_NumberOfPoints;
     if (m_CarriedFrom.size() != 3 * n)
@@ -3116,22 +3136,63 @@ private:
       return false;
     }
     // Squared, with a millionth less for the rounding of the squares.
-    const double            limit = (1.0 - 1e-6) * m_CarriedMargin * m_CarriedMargin;
-    const double *          x0 = m_CarriedFrom.data();
-    constexpr SizeValueType block = SurfaceCollisionDetail::ParallelBlocks::Block;
-    std::vector<uint8_t>    outside((n + block - 1) / block, 0);
+    const double               limit = (1.0 - 1e-6) * m_CarriedMargin * m_CarriedMargin;
+    const double *             x0 = m_CarriedFrom.data();
+    constexpr SizeValueType    block = SurfaceCollisionDetail::ParallelBlocks::Block;
+    std::vector<SizeValueType> outside((n + block - 1) / block, 0);
+    m_CarriedFar.resize(n);
     parallel(n, [&](SizeValueType begin, SizeValueType end) {
-      bool far = false;
+      SizeValueType count = 0;
       for (SizeValueType i = begin; i < end; ++i)
       {
         const double dx = y[3 * i] - x0[3 * i];
         const double dy = y[3 * i + 1] - x0[3 * i + 1];
         const double dz = y[3 * i + 2] - x0[3 * i + 2];
-        far = far || !(dx * dx + dy * dy + dz * dz <= limit); // NaN: far
+        const bool   far = !(dx * dx + dy * dy + dz * dz <= limit); // NaN: far
+        m_CarriedFar[i] = far ? 1 : 0;
+        count += far ? 1 : 0;
       }
-      outside[begin / block] = far ? 1 : 0;
+      outside[begin / block] = count;
     });
-    return std::find(outside.begin(), outside.end(), uint8_t{ 1 }) == outside.end();
+    const SizeValueType far = std::accumulate(outside.begin(), outside.end(), SizeValueType{ 0 });
+    if (far == 0)
+    {
+      return true;
+    }
+    if (far > n / 32)
+    {
+      return false;
+    }
+    const SizeValueType  numberOfTriangles = this->GetNumberOfTriangles();
+    const uint8_t *      flags = m_CarriedFar.data();
+    std::vector<uint8_t> turned((numberOfTriangles + block - 1) / block, 0);
+    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
+      for (SizeValueType t = begin; t < end; ++t)
+      {
+        const IndexType * vt = m_Triangles.data() + 3 * t;
+        if ((flags[vt[0]] | flags[vt[1]] | flags[vt[2]]) == 0)
+        {
+          continue;
+        }
+        const double * ends[3][2];
+        for (unsigned int k = 0; k < 3; ++k)
+        {
+          ends[k][0] = x0 + 3 * static_cast<SizeValueType>(vt[k]);
+          ends[k][1] = y + 3 * static_cast<SizeValueType>(vt[k]);
+        }
+        for (unsigned int choice = 1; choice < 8; ++choice)
+        {
+          if (SurfaceCollisionDetail::Orient3DSign(
+                m_CarriedCentre, ends[0][choice & 1], ends[1][(choice >> 1) & 1], ends[2][(choice >> 2) & 1]) !=
+              m_CarriedSign)
+          {
+            turned[begin / block] = 1;
+            return;
+          }
+        }
+      }
+    });
+    return std::find(turned.begin(), turned.end(), uint8_t{ 1 }) == turned.end();
   }
 
   /** IsStarShaped(), with the passes run by \a parallel; what it found in
@@ -4653,9 +4714,12 @@ private:
   unsigned int  m_CertificateBackoff{ 0 }; // the last wait
   // CarryCertificate(): the positions of the last certificate without
   // folds, and how far every point may move from them (0: no carrying).
-  std::vector<double> m_CarriedFrom;
-  double              m_CarriedMargin{ 0.0 };
-  SizeValueType       m_TotalNumberOfCarriedCertificates{ 0 };
+  std::vector<double>  m_CarriedFrom;
+  double               m_CarriedMargin{ 0.0 };
+  double               m_CarriedCentre[3]{ 0.0, 0.0, 0.0 }; // the certificate's centre
+  int                  m_CarriedSign{ 0 };                  // the orientation of its triangles seen from it
+  std::vector<uint8_t> m_CarriedFar;                        // CarriedTo(): per point, beyond the margin
+  SizeValueType        m_TotalNumberOfCarriedCertificates{ 0 };
   // CarryNow(): the steps certified by the last carried margin, whether one
   // was computed since the last decision, and the wait before the next.
   SizeValueType m_CarryYield{ 0 };

@@ -1105,12 +1105,25 @@ TEST(SurfaceCollision, TheCertificateCarriesToPositionsWithinItsMargin)
     EXPECT_TRUE(fresh.IsStarShaped(y.data()));
     EXPECT_EQ(CheckAllPairs(y, triangles, 0.0).intersecting, 0u);
   }
-  // One point moved by twice the margin: the certificate again (a new
-  // margin, from these positions), not the carried one.
+  // One point moved by twice the margin: its triangles followed from the
+  // certified positions (CarriedTo()), no certificate.
   y = x;
   y[0] += 2.0 * margin;
-  const std::size_t carried = collision.GetTotalNumberOfCarriedCertificates();
-  const std::size_t certified = collision.GetTotalNumberOfCertifiedSteps();
+  std::size_t carried = collision.GetTotalNumberOfCarriedCertificates();
+  std::size_t certified = collision.GetTotalNumberOfCertifiedSteps();
+  EXPECT_EQ(collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1).constrained, 0u);
+  EXPECT_EQ(collision.GetTotalNumberOfCarriedCertificates(), carried + 1);
+  EXPECT_EQ(collision.GetTotalNumberOfCertifiedSteps(), certified + 1);
+  // More than a 32nd of the points (9 of 258) moved by twice the margin:
+  // the certificate again (a new margin, from these positions), not the
+  // carried one.
+  y = x;
+  for (std::size_t i = 0; i <= n / 32; ++i)
+  {
+    y[3 * i] += 2.0 * margin;
+  }
+  carried = collision.GetTotalNumberOfCarriedCertificates();
+  certified = collision.GetTotalNumberOfCertifiedSteps();
   EXPECT_EQ(collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1).constrained, 0u);
   EXPECT_EQ(collision.GetTotalNumberOfCarriedCertificates(), carried);
   EXPECT_EQ(collision.GetTotalNumberOfCertifiedSteps(), certified + 1);
@@ -1133,9 +1146,10 @@ TEST(SurfaceCollision, TheCertificateCarriesToPositionsWithinItsMargin)
   EXPECT_GT(pushed.Constrain(x.data(), through.data(), 0.0, nullptr, 1).constrained, 0u);
   EXPECT_EQ(CheckAllPairs(through, triangles, 0.0).intersecting, 0u);
 
-  // Margins that do not last: point 0 goes out by three margins and back at
-  // every step, so that no step is carried. A margin is computed after the
-  // first certificate, then after waits of 1, 2 and 4 certificates.
+  // Margins that do not last: every point goes out by three margins and
+  // back at every step, so that no step is carried. A margin is computed
+  // after the first certificate, then after waits of 1, 2 and 4
+  // certificates.
   itk::SurfaceCollision jumpy;
   jumpy.SetSurface(n, triangles.data(), numberOfTriangles);
   std::string computed;
@@ -1144,9 +1158,12 @@ TEST(SurfaceCollision, TheCertificateCarriesToPositionsWithinItsMargin)
     y = x;
     if (step % 2 == 1)
     {
-      for (unsigned int d = 0; d < 3; ++d)
+      for (std::size_t i = 0; i < n; ++i)
       {
-        y[d] += 3.0 * margin * (x[d] - centre[d]) / 5.0;
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          y[3 * i + d] += 3.0 * margin * (x[3 * i + d] - centre[d]) / 5.0;
+        }
       }
     }
     EXPECT_EQ(jumpy.Constrain(x.data(), y.data(), 0.0, nullptr, 1).constrained, 0u);
@@ -1155,6 +1172,90 @@ TEST(SurfaceCollision, TheCertificateCarriesToPositionsWithinItsMargin)
   EXPECT_EQ(jumpy.GetTotalNumberOfCertifiedSteps(), 12u);
   EXPECT_EQ(jumpy.GetTotalNumberOfCarriedCertificates(), 0u);
   EXPECT_EQ(computed, "YNYNNYNNNNYN");
+}
+
+TEST(SurfaceCollision, TheCertificateFollowsTheTrianglesOfPointsBeyondItsMargin)
+{
+  // From a carried certificate, steps that move up to 8 of the 258 points
+  // (a 32nd) far beyond the margin, each toward a random point within 1.2
+  // edge lengths, or through the sphere: a step left as proposed
+  // (constrained 0) is free of intersecting pairs by the test of all pairs,
+  // and star-shaped by a fresh certificate when no point went through.
+  // Both ways are taken: steps carried past the margin, and steps that the
+  // certificate, the folds' test or the index decided.
+  std::vector<double>   x;
+  std::vector<uint32_t> triangles;
+  StarSphere(x, triangles);
+  const std::size_t n = x.size() / 3;
+  const std::size_t numberOfTriangles = triangles.size() / 3;
+  std::mt19937      random(11);
+  std::size_t       carriedPast = 0;
+  std::size_t       decidedOtherwise = 0;
+  std::size_t       throughCaught = 0;
+  for (int trial = 0; trial < 120; ++trial)
+  {
+    itk::SurfaceCollision collision;
+    collision.SetSurface(n, triangles.data(), numberOfTriangles);
+    std::vector<double> y = x;
+    ASSERT_EQ(collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1).constrained, 0u);
+    const double margin = collision.GetCarriedMargin();
+    ASSERT_GT(margin, 0.0);
+    const bool                                 through = trial % 4 == 3;
+    const std::size_t                          moved = 1 + static_cast<std::size_t>(trial) % 8;
+    std::uniform_int_distribution<std::size_t> pick(0, n - 1);
+    std::normal_distribution<double>           normal(0.0, 1.0);
+    std::vector<std::size_t>                   chosen;
+    for (std::size_t m = 0; m < moved; ++m)
+    {
+      std::size_t i = pick(random);
+      while (std::find(chosen.begin(), chosen.end(), i) != chosen.end())
+      {
+        i = pick(random);
+      }
+      chosen.push_back(i);
+      if (through && m == 0)
+      {
+        const double centre[3] = { 1.3, -0.7, 2.1 };
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          y[3 * i + d] = centre[d] - 1.5 * (x[3 * i + d] - centre[d]);
+        }
+        continue;
+      }
+      const double scale = 1.2 * 1.1 * std::abs(normal(random)) / std::sqrt(3.0);
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        y[3 * i + d] = x[3 * i + d] + scale * normal(random);
+      }
+    }
+    const std::vector<double> proposed = y;
+    const std::size_t         carried = collision.GetTotalNumberOfCarriedCertificates();
+    const auto                result = collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1);
+    const bool                carriedNow = collision.GetTotalNumberOfCarriedCertificates() > carried;
+    carriedPast += carriedNow ? 1 : 0;
+    decidedOtherwise += carriedNow ? 0 : 1;
+    EXPECT_EQ(CheckAllPairs(y, triangles, 0.0).intersecting, 0u) << "trial " << trial;
+    if (result.constrained == 0)
+    {
+      EXPECT_EQ(y, proposed);
+    }
+    if (carriedNow)
+    {
+      itk::SurfaceCollision fresh;
+      fresh.SetSurface(n, triangles.data(), numberOfTriangles);
+      EXPECT_TRUE(fresh.IsStarShaped(y.data())) << "trial " << trial;
+      EXPECT_FALSE(through) << "trial " << trial << ": a point through the sphere carried";
+    }
+    if (through)
+    {
+      throughCaught += result.constrained > 0 ? 1 : 0;
+    }
+  }
+  std::cout << carriedPast << " steps carried past the margin, " << decidedOtherwise << " decided otherwise, "
+            << throughCaught << " of 30 through the sphere constrained" << std::endl;
+  EXPECT_GT(carriedPast, 20u);
+  EXPECT_GT(decidedOtherwise, 20u);
+  EXPECT_EQ(throughCaught, 30u);
 }
 
 TEST(SurfaceCollision, TheCertificateTakesFoldsThatMeetNothing)
