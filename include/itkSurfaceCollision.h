@@ -1274,8 +1274,9 @@ struct ParallelBlocks
  * certified positions, by 7 exact orientation signs each (CarriedTo()):
  * the certificate is computed again, with new margins, only when more
  * points have left, when one of those triangles may turn on the way, or
- * when the surface changes (SetSurface()). The margins are about a fifth of the edge length on a
- * regular sphere; a surface that settles moves within them for many steps.
+ * when the surface changes (SetSurface()). The margins are about a fifth
+ * of the edge length on a regular sphere; a surface that settles moves
+ * within them for many steps.
  * Where the margins do not last (a surface remeshed every few steps), the
  * margin is computed less often (CarryNow()).
  *
@@ -3116,9 +3117,9 @@ private:
    * At most a 32nd of the points: every triangle with such a point must keep
    * its orientation along the straight path from x0 to y. Along it each
    * point is (1 - t) p0 + t p1, and the orientation determinant, linear in
-   * each of the triangle's three points, is the sum over the 8 choices of
-   * each point's end of (1 - t) or t to the number of points taken at x0 or
-   * at y, times the determinant of that choice: a mean of the 8 with
+   * each of the triangle's three points, is the sum, over the 8 ways of
+   * taking each point at x0 or at y, of (1 - t)^i t^j (i points taken at
+   * x0, j at y) times the determinant of that choice: a mean of the 8 with
    * non-negative weights. When the 7 that involve y have the sign of the
    * certified one (exact signs), the orientation never vanishes on the way.
    * The other triangles keep theirs by the margin, so along the whole path
