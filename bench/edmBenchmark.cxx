@@ -362,7 +362,9 @@ BM_EDM_OneStepPerUpdate(benchmark::State & state)
 // sphere's mean edge length, so that the remesher works on a mesh that the
 // deformation keeps pulling out of the band), 2 threads, 20 steps per update
 // (the output's triangle cells are rebuilt once per update after a
-// remeshing).
+// remeshing); suppress_drift: SuppressTangentialDrift off or on (on, the
+// surface at rest no longer flows along itself, and the remeshings after the
+// first ones have little to do).
 double
 MeanEdgeLength(const MeshType * mesh)
 {
@@ -398,6 +400,7 @@ RunRemeshing(benchmark::State & state, bool collisions)
   model->SetRemeshingEdgeLength(MeanEdgeLength(input));
   model->SetRemeshingInterval(10);
   model->SetPreventSelfIntersections(collisions);
+  model->SetSuppressTangentialDrift(state.range(1) != 0);
   model->SetIterateFromZero(false);
   model->SetNumberOfWorkUnits(4 * threads);
   model->SetNumberOfIterations(1);
@@ -434,8 +437,9 @@ RunRemeshing(benchmark::State & state, bool collisions)
   }
   state.counters["vertex_it/s"] =
     benchmark::Counter(static_cast<double>(vertexIterations), benchmark::Counter::kIsRate);
-  state.SetLabel(collisions ? "remeshing every 10 iterations, collision test every iteration, steps/update=20"
-                            : "remeshing every 10 iterations, steps/update=20");
+  std::string label = collisions ? "remeshing every 10 iterations, collision test every iteration, steps/update=20"
+                                 : "remeshing every 10 iterations, steps/update=20";
+  state.SetLabel(label + (state.range(1) != 0 ? ", SuppressTangentialDrift" : ""));
 }
 
 void
@@ -871,16 +875,14 @@ BENCHMARK(BM_EDM_OneStepPerUpdate)
   ->Unit(benchmark::kMillisecond)
   ->ComputeStatistics("max", Largest);
 BENCHMARK(BM_EDM_Remeshing)
-  ->Arg(100000)
-  ->Arg(1000000)
-  ->ArgName("vertices")
+  ->ArgsProduct({ { 100000, 1000000 }, { 0, 1 } })
+  ->ArgNames({ "vertices", "suppress_drift" })
   ->UseRealTime()
   ->Unit(benchmark::kMillisecond)
   ->ComputeStatistics("max", Largest);
 BENCHMARK(BM_EDM_CollisionsAndRemeshing)
-  ->Arg(100000)
-  ->Arg(1000000)
-  ->ArgName("vertices")
+  ->ArgsProduct({ { 100000, 1000000 }, { 0, 1 } })
+  ->ArgNames({ "vertices", "suppress_drift" })
   ->UseRealTime()
   ->Unit(benchmark::kMillisecond)
   ->ComputeStatistics("max", Largest);

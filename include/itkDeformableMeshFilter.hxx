@@ -1259,9 +1259,12 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   // reference edge length the geometry pass also gives the edge weights.
   const bool useImageTerms = this->UsesImageTerms();
   const bool scaled = m_ReferenceEdgeLength > 0.0 && (useElasticity || m_Rigidity > 0.0);
-  const bool useRigidity = m_Rigidity > 0.0 || useImageTerms || scaled || m_ConvergenceAlongNormals;
-  const bool useNormal =
-    m_Balloon != 0.0 || (useElasticity && m_TangentialElasticity) || useImageTerms || m_ConvergenceAlongNormals;
+  // SuppressTangentialDrift needs the normals and the mesh's edge length:
+  // the geometry pass gives both.
+  const bool suppressDrift = m_SuppressTangentialDrift && m_ScaleFactor != 0.0;
+  const bool useRigidity = m_Rigidity > 0.0 || useImageTerms || scaled || m_ConvergenceAlongNormals || suppressDrift;
+  const bool useNormal = m_Balloon != 0.0 || (useElasticity && m_TangentialElasticity) || useImageTerms ||
+                         m_ConvergenceAlongNormals || suppressDrift;
   if (m_FirstContourEnd >= 0 && (m_Balloon != 0.0 || m_RegionWeight > 0.0))
   {
     // Outward is the side away from the region a closed contour encloses;
@@ -1393,10 +1396,15 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   // many sub-steps of the internal forces as a w + 2 b w^2 <= 1 needs
   // (DeformableMeshUpdateRule::FromParameters()).
   double edgeWeight = 0.0;
+  double driftThreshold = 0.0;
   if (useRigidity)
   {
-    const double meanSquaredEdgeLength = geometryPass(scaled);
+    const double meanSquaredEdgeLength = geometryPass(scaled || suppressDrift);
     edgeWeight = DeformableMeshUpdateRule::EdgeWeight(scaled ? m_ReferenceEdgeLength : 0.0, meanSquaredEdgeLength);
+    if (suppressDrift)
+    {
+      driftThreshold = 0.25 * std::sqrt(meanSquaredEdgeLength);
+    }
   }
   const DeformableMeshUpdateRule rule = DeformableMeshUpdateRule::FromParameters(
     m_ScaleFactor, m_Elasticity, m_Rigidity, m_TangentialElasticity, m_Balloon, m_MaximumStepLength, edgeWeight);
@@ -1418,9 +1426,10 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
     // displacement of the iteration is measured from where it started.
     m_IterationStart.assign(coordinates.begin(), coordinates.end());
     const DeformableMeshUpdateRule internal = rule.InternalOnly();
-    const StepTerms                internalTerms{ internal.scaleFactor, internal.elasticity, internal.rigidity,
-                                   internal.tangential,  internal.balloon,    internal.maximumStepLength,
-                                   m_OrientationSign };
+    const StepTerms                internalTerms{ internal.scaleFactor, internal.elasticity,
+                                   internal.rigidity,    internal.tangential,
+                                   internal.balloon,     internal.maximumStepLength,
+                                   m_OrientationSign,    0.0 };
     for (unsigned int k = 1; k < m_NumberOfSubSteps; ++k)
     {
       stepPass(internalTerms, false);
@@ -1448,8 +1457,8 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
     m_NormalSpeeds.clear();
   }
 
-  const StepTerms terms{ rule.scaleFactor, rule.elasticity,        rule.rigidity,    rule.tangential,
-                         rule.balloon,     rule.maximumStepLength, m_OrientationSign };
+  const StepTerms terms{ rule.scaleFactor, rule.elasticity,        rule.rigidity,     rule.tangential,
+                         rule.balloon,     rule.maximumStepLength, m_OrientationSign, driftThreshold };
   stepPass(terms, diagnose);
   if (m_FixedBoundary && !m_BoundaryVertices.empty())
   {
@@ -1925,6 +1934,7 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "ScaleFactor: " << m_ScaleFactor << std::endl;
   os << indent << "Elasticity: " << m_Elasticity << std::endl;
   os << indent << "TangentialElasticity: " << (m_TangentialElasticity ? "On" : "Off") << std::endl;
+  os << indent << "SuppressTangentialDrift: " << (m_SuppressTangentialDrift ? "On" : "Off") << std::endl;
   os << indent << "Rigidity: " << m_Rigidity << std::endl;
   os << indent << "Balloon: " << m_Balloon << std::endl;
   os << indent << "RegionWeight: " << m_RegionWeight << std::endl;

@@ -105,6 +105,9 @@ struct StepTerms
   double balloon;
   double maximumStep;
   double orientationSign; // +1 outward-oriented mesh, -1 inward
+  // SuppressTangentialDrift: below this external displacement (mm) the
+  // external force acts along the normal only, above twice it whole; 0: off.
+  double driftThreshold;
 };
 
 /** The per-vertex arrays a step reads and writes. */

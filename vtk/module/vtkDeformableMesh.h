@@ -307,6 +307,21 @@ public:
 
   ///@{
   /**
+   * Drop the external force's component tangent to the surface where the
+   * surface has come to rest (external displacement below a quarter of the
+   * mesh's root mean square edge length; whole beyond half of it): the
+   * vertices of a converged surface then stop flowing along it, and the
+   * remeshings stop splitting and collapsing edges. Recommended with
+   * remeshing. Default off.
+   * Meaning in full: itk::DeformableMeshFilter::SetSuppressTangentialDrift().
+   */
+  vtkSetMacro(SuppressTangentialDrift, vtkTypeBool);
+  vtkGetMacro(SuppressTangentialDrift, vtkTypeBool);
+  vtkBooleanMacro(SuppressTangentialDrift, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
    * Reference edge length L: the edge length at which Elasticity and
    * Rigidity have their nominal weight; when positive the internal forces
    * are scaled by (L/h)^2 and (L/h)^4 (h the mesh's root mean square edge
@@ -475,6 +490,7 @@ protected:
   double      MaximumStepLength = 0.0;
   double      RemeshingEdgeLength = 0.0;
   int         RemeshingInterval = 10;
+  vtkTypeBool SuppressTangentialDrift = 0;
   double      RegionWeight = 0.0;
   double      RegionSigma = 1.0;
   double      EdgeSearchWeight = 0.0;

@@ -798,6 +798,7 @@ TEST(VTKIterativeAlgorithms, PrintSelfPrintsEveryParameter)
                              "MaximumStepLength",
                              "RemeshingEdgeLength",
                              "RemeshingInterval",
+                             "SuppressTangentialDrift",
                              "ReferenceEdgeLength",
                              "ConvergenceAlongNormals",
                              "PreventSelfIntersections",
