@@ -265,10 +265,10 @@ public:
 
   /** When on, the external force's component tangent to the surface is
    * dropped at the vertices where the surface has come to rest: where the
-   * external displacement (ScaleFactor times the force) is shorter than a
-   * quarter of the mesh's root mean square edge length h, the vertex moves
-   * along its normal only; between h/4 and h/2 the tangential component is
-   * blended back in (its weight rises linearly from 0 to 1); beyond h/2 the
+   * external displacement (ScaleFactor times the force) is shorter than an
+   * eighth of the mesh's root mean square edge length h, the vertex moves
+   * along its normal only; between h/8 and h/4 the tangential component is
+   * blended back in (its weight rises linearly from 0 to 1); beyond h/4 the
    * force acts whole. Default: off.
    *
    * Why: a force field's tangential component moves vertices along the
@@ -280,12 +280,14 @@ public:
    * and collapses at every remeshing. On the benchmarks' ellipsoid at rest,
    * with remeshing every 10 iterations, 2 to 7 % of the points went through
    * the remesher at every remeshing (the share grows as the edges shrink:
-   * the flow is in mm per iteration); with this option 0.1 to 0.3 %, and
+   * the flow is in mm per iteration); with this option 0.1 to 0.6 %, and
    * the surface is the same (docs/performance.md). Far from the object the
    * step is long against the edges and the field moves neighbouring vertices
    * together; there the normal alone would not (neighbouring normals differ,
-   * and long steps along them crumple a fine mesh), hence the whole force
-   * beyond h/2. Recommended with remeshing (RemeshingEdgeLength > 0). */
+   * and long steps along them fold a fine mesh: with the bounds at h/4 and
+   * h/2 the benchmark's 1M sphere came close to itself while it travelled),
+   * hence the whole force beyond h/4. Recommended with remeshing
+   * (RemeshingEdgeLength > 0). */
   itkSetMacro(SuppressTangentialDrift, bool);
   itkGetConstMacro(SuppressTangentialDrift, bool);
   itkBooleanMacro(SuppressTangentialDrift);

@@ -1403,7 +1403,7 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
     edgeWeight = DeformableMeshUpdateRule::EdgeWeight(scaled ? m_ReferenceEdgeLength : 0.0, meanSquaredEdgeLength);
     if (suppressDrift)
     {
-      driftThreshold = 0.25 * std::sqrt(meanSquaredEdgeLength);
+      driftThreshold = 0.125 * std::sqrt(meanSquaredEdgeLength);
     }
   }
   const DeformableMeshUpdateRule rule = DeformableMeshUpdateRule::FromParameters(

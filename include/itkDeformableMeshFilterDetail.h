@@ -106,7 +106,8 @@ struct StepTerms
   double maximumStep;
   double orientationSign; // +1 outward-oriented mesh, -1 inward
   // SuppressTangentialDrift: below this external displacement (mm) the
-  // external force acts along the normal only, above twice it whole; 0: off.
+  // external force acts along the normal only, above twice it whole (h/8
+  // and h/4, h the root mean square edge length); 0: off.
   double driftThreshold;
 };
 

@@ -308,8 +308,8 @@ public:
   ///@{
   /**
    * Drop the external force's component tangent to the surface where the
-   * surface has come to rest (external displacement below a quarter of the
-   * mesh's root mean square edge length; whole beyond half of it): the
+   * surface has come to rest (external displacement below an eighth of the
+   * mesh's root mean square edge length; whole beyond a quarter of it): the
    * vertices of a converged surface then stop flowing along it, and the
    * remeshings stop splitting and collapsing edges. Recommended with
    * remeshing. Default off.
