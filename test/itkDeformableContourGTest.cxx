@@ -348,6 +348,35 @@ TEST(DeformableContour, CircleReachesAnEllipse)
   }
 }
 
+// SuppressTangentialDrift on a contour: the normal is the contour's, and the
+// contour reaches the ellipse as closely as with the whole force.
+TEST(DeformableContour, SuppressTangentialDriftReachesTheEllipseAsClosely)
+{
+  const Geometry  g = UnitGeometry(72);
+  const PointType center = Point(35.3, 36.1);
+  const auto      image = MakeImage(g, center, InsideEllipse(center, 20.0, 14.0, 0.0));
+  const auto      forces = Forces(image, 1.0, false);
+  double          means[2] = { 0.0, 0.0 };
+  for (const bool suppress : { false, true })
+  {
+    auto filter = FilterType::New();
+    filter->SetInput(MakeCircle(center, 17.0, 200));
+    filter->SetForceImage(forces);
+    filter->SetScaleFactor(0.5);
+    filter->SetElasticity(0.3);
+    filter->SetSuppressTangentialDrift(suppress);
+    filter->SetNumberOfIterations(400);
+    filter->Update();
+    double maximum = 0.0;
+    MeasureDistance(filter->GetOutput(), Ellipse(center, 20.0, 14.0, 0.0), means[suppress], maximum);
+    std::cout << (suppress ? "suppressed" : "whole force") << ": mean " << means[suppress] << " pixel, max " << maximum
+              << " pixel" << std::endl;
+    EXPECT_LE(means[suppress], 0.1);
+    EXPECT_LE(maximum, 0.3);
+  }
+  EXPECT_NEAR(means[1], means[0], 0.02);
+}
+
 // The same physical ellipse, rotated by 0.3 rad, imaged with pixels of
 // 0.6 x 1.0 mm, a direction rotated by 0.5 rad and an origin away from 0:
 // the tolerances in units of the smallest spacing (0.6 mm).
