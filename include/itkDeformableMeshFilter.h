@@ -147,7 +147,10 @@ namespace itk
  * is refused with an ExceptionObject at the first update); boundary edges are
  * split but kept, non-manifold parts left alone (DeformableMeshRemesher).
  * The balloon's per-vertex release and the diagnostics of a new vertex are
- * those of its parent vertex.
+ * those of its parent vertex. Once the surface rests on the object, the
+ * force's tangential part keeps its vertices flowing along it, and every
+ * remeshing splits and collapses edges where they leave and gather:
+ * SuppressTangentialDrift stops that flow.
  *
  * Renumbering: at each reset, an input whose numbering is not local (more
  * than a tenth of its edges join points numbered more than 2048 apart, as in
