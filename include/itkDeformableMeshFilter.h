@@ -290,7 +290,8 @@ public:
    * and long steps along them fold a fine mesh: with the bounds at h/4 and
    * h/2 the benchmark's 1M sphere came close to itself while it travelled),
    * hence the whole force beyond h/4. Recommended with remeshing
-   * (RemeshingEdgeLength > 0). */
+   * (RemeshingEdgeLength > 0). GetExternalForceMagnitudes() then gives the
+   * external force as applied, its tangential part dropped or weighted. */
   itkSetMacro(SuppressTangentialDrift, bool);
   itkGetConstMacro(SuppressTangentialDrift, bool);
   itkBooleanMacro(SuppressTangentialDrift);
