@@ -610,6 +610,8 @@ private:
   };
   std::vector<uint8_t>   m_Touched;
   std::vector<uint8_t>   m_RelaxSet;
+  std::vector<IndexType> m_FlipSeeds;  // scratch of FlipPass(), incremental: the touched points
+  std::vector<uint64_t>  m_FlipMarked; // scratch of FlipPass(), incremental: the corners to test
   bool                   m_Local{ false };
   std::vector<IndexType> m_SplitTouched; // triangles the splits of a pass changed or made
   // The short edges found by the scan of SplitPass(true), a bit per corner
@@ -1830,15 +1832,92 @@ inline void
 DeformableMeshRemesher::FlipPass()
 {
   m_StillShortValid = false;
-  this->Sweep(
-    SweepInputs::Valences,
-    [this](IndexType c) { return m_V[c] != Invalid && this->FlipImprovesValences(c, m_Local); },
-    [this](SweepWorker & worker, IndexType c) {
-      if (m_V[c] != Invalid && m_O[c] >= static_cast<int64_t>(c))
+  const auto body = [this](SweepWorker & worker, IndexType c) {
+    if (m_V[c] != Invalid && m_O[c] >= static_cast<int64_t>(c))
+    {
+      this->TryFlip(worker, c);
+    }
+  };
+  if (!m_Local)
+  {
+    this->Sweep(
+      SweepInputs::Valences,
+      [this](IndexType c) { return m_V[c] != Invalid && this->FlipImprovesValences(c, false); },
+      body);
+    return;
+  }
+  // Incremental: FlipImprovesValences() considers an edge only when one of
+  // its four points (those of its two triangles) is touched. On a mesh at
+  // rest a few thousand points of a million are: the corners of the
+  // triangles around them, and their twins, are the only ones to test,
+  // instead of a scan of the whole corner table. The same queue as the scan
+  // (a touched point's fan holds the edge's triangle or its twin's), which
+  // is run when the touched points are many or one's fan cannot be walked
+  // (non-manifold).
+  const std::size_t        numberOfPoints = m_State.size();
+  const std::size_t        numberOfCorners = m_V.size();
+  std::vector<IndexType> & touched = m_FlipSeeds;
+  touched.clear();
+  bool targeted = true;
+  for (std::size_t v = 0; v < numberOfPoints && targeted; ++v)
+  {
+    if ((m_Touched[v] & TouchedSinceFlips) != 0 && m_VertexCorner[v] != Invalid && m_State[v] < RemesherFrozen)
+    {
+      touched.push_back(static_cast<IndexType>(v));
+      targeted = 16 * touched.size() <= numberOfPoints;
+    }
+  }
+  if (!targeted)
+  {
+    this->Sweep(
+      SweepInputs::Valences,
+      [this](IndexType c) { return m_V[c] != Invalid && this->FlipImprovesValences(c, true); },
+      body);
+    return;
+  }
+  const std::size_t       words = (numberOfCorners + 63) / 64;
+  std::vector<uint64_t> & marked = m_FlipMarked;
+  marked.assign(words, 0);
+  std::vector<IndexType> & ring = m_SerialWorker.ringA;
+  std::vector<IndexType> & corners = m_SerialWorker.cornersA;
+  for (const IndexType v : touched)
+  {
+    if (!this->Ring(v, ring, &corners))
+    {
+      // A fan that cannot be walked: the scan.
+      this->Sweep(
+        SweepInputs::Valences,
+        [this](IndexType c) { return m_V[c] != Invalid && this->FlipImprovesValences(c, true); },
+        body);
+      return;
+    }
+    for (const IndexType k : corners)
+    {
+      const IndexType first = k - k % 3;
+      for (IndexType c = first; c < first + 3; ++c)
       {
-        this->TryFlip(worker, c);
+        marked[c >> 6] |= uint64_t{ 1 } << (c & 63);
+        const Link o = m_O[c];
+        if (o >= 0)
+        {
+          marked[static_cast<std::size_t>(o) >> 6] |= uint64_t{ 1 } << (o & 63);
+        }
       }
-    });
+    }
+  }
+  m_Queue.assign(words, 0);
+  for (std::size_t w = 0; w < words; ++w)
+  {
+    for (uint64_t bits = marked[w]; bits != 0; bits &= bits - 1)
+    {
+      const auto c = static_cast<IndexType>(64 * w + LowestBit(bits));
+      if (m_V[c] != Invalid && this->FlipImprovesValences(c, true))
+      {
+        m_Queue[w] |= uint64_t{ 1 } << (c & 63);
+      }
+    }
+  }
+  this->RunQueue(SweepInputs::Valences, body);
 }
 
 inline void
@@ -2334,12 +2413,33 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
                                                         << coordinates.size() << " coordinates for " << numberOfPoints
                                                         << " points.");
   }
-  for (const IndexType v : triangles)
+  // In parallel (a serial pass over the corners costs about as much as a
+  // remeshing's operations on a large mesh at rest); the first bad point for
+  // the message.
+  std::atomic<bool> outOfRange{ false };
+  this->ParallelFor(
+    triangles.size(),
+    [&](std::size_t first, std::size_t last) {
+      IndexType largest = 0;
+      for (std::size_t c = first; c < last; ++c)
+      {
+        largest = std::max(largest, triangles[c]);
+      }
+      if (last > first && largest >= numberOfPoints)
+      {
+        outOfRange = true;
+      }
+    },
+    65536);
+  if (outOfRange)
   {
-    if (v >= numberOfPoints)
+    for (const IndexType v : triangles)
     {
-      itkGenericExceptionMacro("DeformableMeshRemesher: a triangle refers to point " << v << " of " << numberOfPoints
-                                                                                     << ".");
+      if (v >= numberOfPoints)
+      {
+        itkGenericExceptionMacro("DeformableMeshRemesher: a triangle refers to point " << v << " of " << numberOfPoints
+                                                                                       << ".");
+      }
     }
   }
   m_Statistics = Statistics{};
@@ -2358,8 +2458,21 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
   std::vector<uint8_t> locked;
   locked.swap(m_Locked);
   const bool lock = std::find(locked.begin(), locked.end(), uint8_t{ 1 }) != locked.end();
-  const bool reuse = !lock && m_TableValid && m_State.size() == numberOfPoints && m_V.size() == triangles.size() &&
-                     std::equal(triangles.begin(), triangles.end(), m_V.begin());
+  bool       reuse = !lock && m_TableValid && m_State.size() == numberOfPoints && m_V.size() == triangles.size();
+  if (reuse)
+  {
+    std::atomic<bool> differs{ false };
+    this->ParallelFor(
+      triangles.size(),
+      [&](std::size_t first, std::size_t last) {
+        if (!std::equal(triangles.begin() + first, triangles.begin() + last, m_V.begin() + first))
+        {
+          differs = true;
+        }
+      },
+      65536);
+    reuse = !differs;
+  }
   m_TableValid = false;
   if (!reuse)
   {
