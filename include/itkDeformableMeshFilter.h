@@ -158,7 +158,16 @@ namespace itk
  * along a Morton curve of its positions, so that the step's speed does not
  * depend on the input's numbering; the output keeps the input's numbering
  * and the diagnostics are indexed by the input's point identifiers. A
- * remeshed mesh keeps a local numbering (DeformableMeshRemesher).
+ * remeshing keeps the numbering of the points it keeps and numbers each new
+ * point after the one it comes from (DeformableMeshRemesher); after many
+ * operations (a surface that travelled far from its start, a tenth of the
+ * points split or collapsed since the last renumbering), the remeshed mesh
+ * is renumbered breadth-first along its edges (DeformableMeshRemesher::
+ * BreadthFirstOrder()): the step's neighbour reads stay in the caches
+ * (measured: 20 steps on the 1M-point benchmark surface at rest, remeshed
+ * from a sphere, 342 to 493 ms as the remeshings left it, 274 to 337 ms
+ * renumbered, 240 to 322 ms on the sphere). The output is the renumbered
+ * mesh; GetNumberOfLocalityRenumberings() counts them.
  *
  * 2-D contours (snakes): with an itk::Mesh of 2-D points and a 2-D force
  * image (vectors of 2 components, e.g. ExternalForceImageFilter on a 2-D
@@ -704,11 +713,16 @@ public:
   itkGetConstMacro(NumberOfPointsLockedByRemeshing, SizeValueType);
 
   /** When on (default), an input whose numbering is not local is renumbered
-   * internally at reset (see the class documentation). Off keeps the
-   * input's order (for measurements). */
+   * internally at reset, and a remeshed mesh after many remeshing operations
+   * (see the class documentation). Off keeps the input's order and the
+   * remesher's (for measurements). */
   itkSetMacro(RenumberForLocality, bool);
   itkGetConstMacro(RenumberForLocality, bool);
   itkBooleanMacro(RenumberForLocality);
+
+  /** The number of renumberings of a remeshed mesh since the last reset
+   * (see the class documentation). */
+  itkGetConstMacro(NumberOfLocalityRenumberings, SizeValueType);
 
   /** Sign applied to the triangles' orientation to get outward normals: +1 for
    * an outward-oriented mesh, -1 for an inward-oriented one. Set by Reset()
@@ -844,6 +858,11 @@ private:
    * \a triangles (the surface before the remeshing, clear) with the points
    * around the contacts that the remeshing made locked, until it makes
    * none. */
+  /** Renumbers the last remeshing's output \a x (and m_Triangles, and the
+   * remesher's table) breadth-first when the operations since the last
+   * renumbering call for it (see the class documentation). */
+  void
+  RenumberRemeshed(std::vector<double> & x);
   void
   RemeshWithoutContacts(const std::vector<double> & x, const std::vector<IndexType32> & triangles);
 
@@ -853,6 +872,9 @@ private:
 
   static constexpr SizeValueType RenumberingWindow = 2048;
   static constexpr double        RenumberingFarEdgeFraction = 0.1;
+  // A remeshed mesh is renumbered once the splits and collapses since the
+  // last renumbering (or the reset) exceed this fraction of its points.
+  static constexpr double RenumberingOperationFraction = 0.1;
 
   void
   PrepareForceSampler();
@@ -970,6 +992,8 @@ private:
   bool                     m_RenumberForLocality{ true };
   bool                     m_Renumbered{ false };
   double                   m_FarEdgeFraction{ 0.0 };
+  SizeValueType            m_OperationsSinceRenumbering{ 0 };
+  SizeValueType            m_NumberOfLocalityRenumberings{ 0 };
   SizeValueType            m_NumberOfRemeshings{ 0 };
   RemeshingStatisticsType  m_RemeshingStatistics;
   SizeValueType            m_NumberOfPointsLockedByRemeshing{ 0 };

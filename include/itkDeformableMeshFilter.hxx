@@ -936,6 +936,8 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
     std::vector<IndexType32>().swap(m_Triangles);
   }
   m_NumberOfRemeshings = 0;
+  m_OperationsSinceRenumbering = 0;
+  m_NumberOfLocalityRenumberings = 0;
   m_RemeshingStatistics = RemeshingStatisticsType{};
   m_NumberOfPointsLockedByRemeshing = 0;
   m_Remesher.ForgetTable();
@@ -1625,11 +1627,22 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
     const std::vector<double>      before(x);
     const std::vector<IndexType32> beforeTriangles(m_Triangles);
     m_Remesher.Remesh(x, numberOfPoints, m_Triangles);
+    const SizeValueType operations = m_OperationsSinceRenumbering;
+    const SizeValueType renumberings = m_NumberOfLocalityRenumberings;
+    this->RenumberRemeshed(x);
     this->RemeshWithoutContacts(before, beforeTriangles);
+    if (m_NumberOfPointsLockedByRemeshing > 0)
+    {
+      // Remeshed again from the input, with points locked: not renumbered.
+      const RemeshingStatisticsType & again = m_Remesher.GetStatistics();
+      m_OperationsSinceRenumbering = operations + again.splits + again.collapses;
+      m_NumberOfLocalityRenumberings = renumberings;
+    }
   }
   else
   {
     m_Remesher.Remesh(x, numberOfPoints, m_Triangles);
+    this->RenumberRemeshed(x);
   }
   const RemeshingStatisticsType & last = m_Remesher.GetStatistics();
   m_RemeshingStatistics.splits += last.splits;
@@ -1709,6 +1722,47 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
   {
     this->ResetCollision(&m_Triangles, false);
   }
+}
+
+template <typename TMesh, typename TForceImage>
+void
+DeformableMeshFilter<TMesh, TForceImage>::RenumberRemeshed(std::vector<double> & x)
+{
+  // After many operations, the breadth-first numbering (see the class
+  // documentation), the remesher's table renumbered with the points, so that
+  // what follows (the contact check, the per-vertex state carried from
+  // Parents(), the step's tables from the remesher's fans) sees a remeshing
+  // whose output is numbered so, and the next remeshing stays incremental.
+  const RemeshingStatisticsType & last = m_Remesher.GetStatistics();
+  m_OperationsSinceRenumbering += last.splits + last.collapses;
+  const SizeValueType numberOfPoints = m_Remesher.Parents().size();
+  if (!m_RenumberForLocality || !m_Remesher.GetTopologyChanged() || numberOfPoints <= RenumberingWindow ||
+      x.size() != 3 * numberOfPoints ||
+      static_cast<double>(m_OperationsSinceRenumbering) <=
+        RenumberingOperationFraction * static_cast<double>(numberOfPoints))
+  {
+    return;
+  }
+  std::vector<uint64_t> edges;
+  m_Remesher.Edges(edges);
+  const std::vector<IndexType32> order = DeformableMeshRemesher::BreadthFirstOrder(x.data(), numberOfPoints, edges);
+  std::vector<IndexType32>       rank(numberOfPoints);
+  std::vector<double>            permuted(3 * numberOfPoints);
+  for (SizeValueType k = 0; k < numberOfPoints; ++k)
+  {
+    rank[order[k]] = static_cast<IndexType32>(k);
+    std::copy(x.data() + 3 * static_cast<SizeValueType>(order[k]),
+              x.data() + 3 * static_cast<SizeValueType>(order[k]) + 3,
+              permuted.data() + 3 * k);
+  }
+  x.swap(permuted);
+  for (IndexType32 & v : m_Triangles)
+  {
+    v = rank[v];
+  }
+  m_Remesher.RenumberOutput(order);
+  m_OperationsSinceRenumbering = 0;
+  ++m_NumberOfLocalityRenumberings;
 }
 
 template <typename TMesh, typename TForceImage>
@@ -1989,6 +2043,8 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "RenumberForLocality: " << (m_RenumberForLocality ? "On" : "Off") << std::endl;
   os << indent << "Renumbered: " << (m_Renumbered ? "true" : "false") << " (far edge fraction " << m_FarEdgeFraction
      << ")" << std::endl;
+  os << indent << "NumberOfLocalityRenumberings: " << m_NumberOfLocalityRenumberings << " ("
+     << m_OperationsSinceRenumbering << " remeshing operations since the last)" << std::endl;
   os << indent << "ForceBuffer: " << m_ForceBuffer << std::endl;
   os << indent << "PhysicalToIndex: [" << m_PhysicalToIndex[0][0] << ' ' << m_PhysicalToIndex[0][1] << ' '
      << m_PhysicalToIndex[0][2] << "; " << m_PhysicalToIndex[1][0] << ' ' << m_PhysicalToIndex[1][1] << ' '

@@ -309,6 +309,15 @@ public:
     return m_Parents;
   }
 
+  /** Renumbers the points of the last Remesh()'s output: \a order[k] is
+   * the point that takes number k (a permutation of the output's points).
+   * The kept table follows, so that the next Remesh() of the renumbered
+   * output (its triangles with each point replaced by its new number) reuses
+   * it, incrementally (SetIncremental()), as it would the output itself;
+   * Parents() and OutputPointChanged() follow too. */
+  void
+  RenumberOutput(const std::vector<IndexType> & order);
+
   /** A renumbering of \a numberOfPoints points for locality: order[k] is the
    * point that takes number k. The points are sorted along a Morton
    * (Z-order) curve of their positions on a 2^21 grid over their bounding
@@ -2365,6 +2374,54 @@ DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<I
   for (std::size_t c = m_V.size(); c-- > 0;)
   {
     m_VertexCorner[m_V[c]] = static_cast<IndexType>(c);
+  }
+}
+
+inline void
+DeformableMeshRemesher::RenumberOutput(const std::vector<IndexType> & order)
+{
+  const std::size_t numberOfPoints = m_State.size();
+  if (order.size() != numberOfPoints)
+  {
+    itkGenericExceptionMacro("DeformableMeshRemesher: a renumbering of " << order.size() << " points for an output of "
+                                                                         << numberOfPoints << ".");
+  }
+  std::vector<IndexType> rank(numberOfPoints, Invalid);
+  for (std::size_t k = 0; k < numberOfPoints; ++k)
+  {
+    if (order[k] >= numberOfPoints || rank[order[k]] != Invalid)
+    {
+      itkGenericExceptionMacro("DeformableMeshRemesher: the renumbering is not a permutation of the output's points.");
+    }
+    rank[order[k]] = static_cast<IndexType>(k);
+  }
+  const auto permute = [&order, numberOfPoints](auto & values) {
+    std::remove_reference_t<decltype(values)> permuted(numberOfPoints);
+    for (std::size_t k = 0; k < numberOfPoints; ++k)
+    {
+      permuted[k] = values[order[k]];
+    }
+    values.swap(permuted);
+  };
+  permute(m_State);
+  permute(m_Touched);
+  permute(m_Valence);
+  permute(m_VertexCorner);
+  permute(m_Parents);
+  std::vector<double> x(3 * numberOfPoints);
+  for (std::size_t k = 0; k < numberOfPoints; ++k)
+  {
+    std::copy(m_X.data() + 3 * static_cast<std::size_t>(order[k]),
+              m_X.data() + 3 * static_cast<std::size_t>(order[k]) + 3,
+              x.data() + 3 * k);
+  }
+  m_X.swap(x);
+  for (IndexType & v : m_V)
+  {
+    if (v != Invalid)
+    {
+      v = rank[v];
+    }
   }
 }
 

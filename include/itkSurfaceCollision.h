@@ -1430,6 +1430,14 @@ public:
     m_Closed = closed;
     m_CertificateWait = 0;
     m_CertificateBackoff = 0;
+    // A carried certificate that the new surface ends (a remeshing), not
+    // one that failed, does not make the next tries wait (CarryNow()): else
+    // a carry tried a step before a remeshing, ended after one step, would
+    // hold the carries back for 64 certificates.
+    if (m_CarryTried && m_CarriedMargin > 0.0)
+    {
+      m_CarryYield = std::max<SizeValueType>(m_CarryYield, 2);
+    }
     m_CarriedMargin = 0.0;
     m_HasSurface = true;
     this->Invalidate();
