@@ -1588,16 +1588,7 @@ DeformableMeshFilter<TMesh, TForceImage>::RenumberForLocality(std::vector<IndexT
   }
   std::vector<double> &          x = this->GetCoordinates();
   const std::vector<IndexType32> order = DeformableMeshRemesher::BreadthFirstOrder(x.data(), numberOfPoints, edges);
-  std::vector<IndexType32>       rank(numberOfPoints);
-  std::vector<double>            permuted(3 * numberOfPoints);
-  for (SizeValueType k = 0; k < numberOfPoints; ++k)
-  {
-    rank[order[k]] = static_cast<IndexType32>(k);
-    std::copy(x.data() + 3 * static_cast<SizeValueType>(order[k]),
-              x.data() + 3 * static_cast<SizeValueType>(order[k]) + 3,
-              permuted.data() + 3 * k);
-  }
-  std::copy(permuted.begin(), permuted.end(), x.begin());
+  const std::vector<IndexType32> rank = ApplyOrder(x, order);
   for (IndexType32 & v : triangles)
   {
     v = rank[v];
@@ -1725,6 +1716,24 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
 }
 
 template <typename TMesh, typename TForceImage>
+std::vector<typename DeformableMeshFilter<TMesh, TForceImage>::IndexType32>
+DeformableMeshFilter<TMesh, TForceImage>::ApplyOrder(std::vector<double> & x, const std::vector<IndexType32> & order)
+{
+  const SizeValueType      numberOfPoints = order.size();
+  std::vector<IndexType32> rank(numberOfPoints);
+  std::vector<double>      permuted(3 * numberOfPoints);
+  for (SizeValueType k = 0; k < numberOfPoints; ++k)
+  {
+    rank[order[k]] = static_cast<IndexType32>(k);
+    std::copy(x.data() + 3 * static_cast<SizeValueType>(order[k]),
+              x.data() + 3 * static_cast<SizeValueType>(order[k]) + 3,
+              permuted.data() + 3 * k);
+  }
+  std::copy(permuted.begin(), permuted.end(), x.begin());
+  return rank;
+}
+
+template <typename TMesh, typename TForceImage>
 void
 DeformableMeshFilter<TMesh, TForceImage>::RenumberRemeshed(std::vector<double> & x)
 {
@@ -1746,16 +1755,7 @@ DeformableMeshFilter<TMesh, TForceImage>::RenumberRemeshed(std::vector<double> &
   std::vector<uint64_t> edges;
   m_Remesher.Edges(edges);
   const std::vector<IndexType32> order = DeformableMeshRemesher::BreadthFirstOrder(x.data(), numberOfPoints, edges);
-  std::vector<IndexType32>       rank(numberOfPoints);
-  std::vector<double>            permuted(3 * numberOfPoints);
-  for (SizeValueType k = 0; k < numberOfPoints; ++k)
-  {
-    rank[order[k]] = static_cast<IndexType32>(k);
-    std::copy(x.data() + 3 * static_cast<SizeValueType>(order[k]),
-              x.data() + 3 * static_cast<SizeValueType>(order[k]) + 3,
-              permuted.data() + 3 * k);
-  }
-  x.swap(permuted);
+  const std::vector<IndexType32> rank = ApplyOrder(x, order);
   for (IndexType32 & v : m_Triangles)
   {
     v = rank[v];

@@ -1847,12 +1847,17 @@ DeformableMeshRemesher::FlipPass()
       this->TryFlip(worker, c);
     }
   };
-  if (!m_Local)
-  {
+  // The scan of the whole table (FlipImprovesValences()'s test, of touched
+  // points only when incremental).
+  const auto scan = [this, &body]() {
     this->Sweep(
       SweepInputs::Valences,
-      [this](IndexType c) { return m_V[c] != Invalid && this->FlipImprovesValences(c, false); },
+      [this](IndexType c) { return m_V[c] != Invalid && this->FlipImprovesValences(c, m_Local); },
       body);
+  };
+  if (!m_Local)
+  {
+    scan();
     return;
   }
   // Incremental: FlipImprovesValences() considers an edge only when one of
@@ -1878,10 +1883,7 @@ DeformableMeshRemesher::FlipPass()
   }
   if (!targeted)
   {
-    this->Sweep(
-      SweepInputs::Valences,
-      [this](IndexType c) { return m_V[c] != Invalid && this->FlipImprovesValences(c, true); },
-      body);
+    scan();
     return;
   }
   const std::size_t       words = (numberOfCorners + 63) / 64;
@@ -1893,11 +1895,7 @@ DeformableMeshRemesher::FlipPass()
   {
     if (!this->Ring(v, ring, &corners))
     {
-      // A fan that cannot be walked: the scan.
-      this->Sweep(
-        SweepInputs::Valences,
-        [this](IndexType c) { return m_V[c] != Invalid && this->FlipImprovesValences(c, true); },
-        body);
+      scan(); // a fan that cannot be walked
       return;
     }
     for (const IndexType k : corners)
