@@ -163,11 +163,14 @@ namespace itk
  * operations (a surface that travelled far from its start, a tenth of the
  * points split or collapsed since the last renumbering), the remeshed mesh
  * is renumbered breadth-first along its edges (DeformableMeshRemesher::
- * BreadthFirstOrder()): the step's neighbour reads stay in the caches
- * (measured: 20 steps on the 1M-point benchmark surface at rest, remeshed
- * from a sphere, 342 to 493 ms as the remeshings left it, 274 to 337 ms
- * renumbered, 240 to 322 ms on the sphere). The output is the renumbered
- * mesh; GetNumberOfLocalityRenumberings() counts them.
+ * OutputBreadthFirstOrder()), and its triangles reordered by their smallest
+ * point (DeformableMeshRemesher::RenumberOutput()): the step's neighbour
+ * reads, and the scans of the triangles by the collision test and the next
+ * remeshing, stay in the caches (measured: 20 steps on the 1M-point
+ * benchmark surface at rest, remeshed from a sphere, 342 to 493 ms as the
+ * remeshings left it, 274 to 337 ms renumbered, 240 to 322 ms on the
+ * sphere). The output is the renumbered mesh;
+ * GetNumberOfLocalityRenumberings() counts them.
  *
  * 2-D contours (snakes): with an itk::Mesh of 2-D points and a 2-D force
  * image (vectors of 2 components, e.g. ExternalForceImageFilter on a 2-D

@@ -1752,15 +1752,13 @@ DeformableMeshFilter<TMesh, TForceImage>::RenumberRemeshed(std::vector<double> &
   {
     return;
   }
-  std::vector<uint64_t> edges;
-  m_Remesher.Edges(edges);
-  const std::vector<IndexType32> order = DeformableMeshRemesher::BreadthFirstOrder(x.data(), numberOfPoints, edges);
-  const std::vector<IndexType32> rank = ApplyOrder(x, order);
-  for (IndexType32 & v : m_Triangles)
+  const std::vector<IndexType32> order = m_Remesher.OutputBreadthFirstOrder(x.data());
+  // The triangles renumbered and reordered with the remesher's table.
+  if (order.size() != numberOfPoints || !m_Remesher.RenumberOutput(order, m_Triangles))
   {
-    v = rank[v];
+    return;
   }
-  m_Remesher.RenumberOutput(order);
+  ApplyOrder(x, order);
   m_OperationsSinceRenumbering = 0;
   ++m_NumberOfLocalityRenumberings;
 }

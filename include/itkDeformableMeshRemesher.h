@@ -311,12 +311,18 @@ public:
 
   /** Renumbers the points of the last Remesh()'s output: \a order[k] is
    * the point that takes number k (a permutation of the output's points).
-   * The kept table follows, so that the next Remesh() of the renumbered
-   * output (its triangles with each point replaced by its new number) reuses
-   * it, incrementally (SetIncremental()), as it would the output itself;
-   * Parents() and OutputPointChanged() follow too. */
-  void
-  RenumberOutput(const std::vector<IndexType> & order);
+   * \a triangles, the output's triangles as Remesh() returned them, are
+   * renumbered and reordered as Remesh() orders its output (by the smallest
+   * new number of their points, stably), so that the triangles around a
+   * point sit near each other in memory as the points do. The kept table
+   * follows, so that the next Remesh() of the renumbered output reuses it,
+   * incrementally (SetIncremental()), as it would the output itself;
+   * Parents() and OutputPointChanged() follow too. Coordinates are the
+   * caller's to permute (coordinates of new point k: those of order[k]).
+   * False, and nothing changed, when no table describes the output (after a
+   * Remesh() with locked vertices, or one whose table could not be kept). */
+  bool
+  RenumberOutput(const std::vector<IndexType> & order, std::vector<IndexType> & triangles);
 
   /** A renumbering of \a numberOfPoints points for locality: order[k] is the
    * point that takes number k. The points are sorted along a Morton
@@ -324,6 +330,22 @@ public:
    * box, so that neighbours on a surface mostly get close numbers. */
   static std::vector<IndexType>
   LocalityOrder(const double * coordinates, std::size_t numberOfPoints);
+
+  /** The Morton codes of LocalityOrder(): the 21-bit grid coordinates of
+   * each point over the bounding box, interleaved. */
+  static std::vector<uint64_t>
+  MortonKeys(const double * coordinates, std::size_t numberOfPoints);
+
+  /** The breadth-first walk over the neighbour lists \a neighbours[offsets[v]]
+   * to neighbours[offsets[v + 1]] of each point v: with \a morton, each
+   * connected part from its first point in LocalityOrder()
+   * (BreadthFirstOrder()); without, as OutputBreadthFirstOrder() says. */
+  static std::vector<IndexType>
+  BreadthFirstWalk(const double *                 coordinates,
+                   std::size_t                    numberOfPoints,
+                   const std::vector<IndexType> & offsets,
+                   const std::vector<IndexType> & neighbours,
+                   bool                           morton);
 
   /** A renumbering for locality that follows the surface: a breadth-first
    * walk over the \a edges ((min << 32 | max) of their end-points), from
@@ -333,6 +355,17 @@ public:
    * the step reads in order. order[k] is the point that takes number k. */
   static std::vector<IndexType>
   BreadthFirstOrder(const double * coordinates, std::size_t numberOfPoints, const std::vector<uint64_t> & edges);
+
+  /** A breadth-first numbering of the last Remesh()'s output (\a
+   * coordinates: its points), as BreadthFirstOrder() gives, with its
+   * neighbours read from the kept table instead of a list of edges, and
+   * without the Morton order of all the points: the walk starts from the
+   * point of smallest coordinate along the longest side of the bounding box,
+   * then covers the other connected parts, if any, each from its point of
+   * smallest number. Empty when no table describes the output (see
+   * RenumberOutput()). */
+  std::vector<IndexType>
+  OutputBreadthFirstOrder(const double * coordinates) const;
 
   /** A locality measure of a numbering: the fraction of the edges of the
    * triangles whose end-points are numbered more than \a window apart. */
@@ -2375,16 +2408,40 @@ DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<I
   }
 }
 
-inline void
-DeformableMeshRemesher::RenumberOutput(const std::vector<IndexType> & order)
+inline bool
+DeformableMeshRemesher::RenumberOutput(const std::vector<IndexType> & order, std::vector<IndexType> & triangles)
 {
+  if (!m_TableValid)
+  {
+    return false;
+  }
   const std::size_t numberOfPoints = m_State.size();
+  const std::size_t numberOfCorners = m_V.size();
   if (order.size() != numberOfPoints)
   {
     itkGenericExceptionMacro("DeformableMeshRemesher: a renumbering of " << order.size() << " points for an output of "
                                                                          << numberOfPoints << ".");
   }
-  std::vector<IndexType> rank(numberOfPoints, Invalid);
+  std::atomic<bool> differs{ triangles.size() != numberOfCorners };
+  if (!differs)
+  {
+    this->ParallelFor(
+      numberOfCorners,
+      [&](std::size_t first, std::size_t last) {
+        if (!std::equal(triangles.begin() + first, triangles.begin() + last, m_V.begin() + first))
+        {
+          differs = true;
+        }
+      },
+      65536);
+  }
+  if (differs)
+  {
+    itkGenericExceptionMacro("DeformableMeshRemesher: RenumberOutput() needs the triangles of the last Remesh()'s "
+                             "output.");
+  }
+  std::vector<IndexType> & rank = m_NewIndex;
+  rank.assign(numberOfPoints, Invalid);
   for (std::size_t k = 0; k < numberOfPoints; ++k)
   {
     if (order[k] >= numberOfPoints || rank[order[k]] != Invalid)
@@ -2393,34 +2450,83 @@ DeformableMeshRemesher::RenumberOutput(const std::vector<IndexType> & order)
     }
     rank[order[k]] = static_cast<IndexType>(k);
   }
-  const auto permute = [&order, numberOfPoints](auto & values) {
-    std::remove_reference_t<decltype(values)> permuted(numberOfPoints);
-    for (std::size_t k = 0; k < numberOfPoints; ++k)
-    {
-      permuted[k] = values[order[k]];
-    }
-    values.swap(permuted);
+  // The per-point arrays, in parallel.
+  const auto permute = [this, &order, numberOfPoints](auto & values, auto & scratch) {
+    scratch.resize(numberOfPoints);
+    this->ParallelFor(numberOfPoints, [&](std::size_t first, std::size_t last) {
+      for (std::size_t k = first; k < last; ++k)
+      {
+        scratch[k] = values[order[k]];
+      }
+    });
+    values.swap(scratch);
   };
-  permute(m_State);
-  permute(m_Touched);
-  permute(m_Valence);
-  permute(m_VertexCorner);
-  permute(m_Parents);
-  std::vector<double> x(3 * numberOfPoints);
-  for (std::size_t k = 0; k < numberOfPoints; ++k)
-  {
-    std::copy(m_X.data() + 3 * static_cast<std::size_t>(order[k]),
-              m_X.data() + 3 * static_cast<std::size_t>(order[k]) + 3,
-              x.data() + 3 * k);
-  }
-  m_X.swap(x);
-  for (IndexType & v : m_V)
-  {
-    if (v != Invalid)
+  permute(m_State, m_ScratchState);
+  permute(m_Touched, m_ScratchTouched);
+  permute(m_Valence, m_ScratchValence);
+  permute(m_Parents, m_ScratchParents);
+  std::vector<double> & x = m_Moved;
+  x.resize(3 * numberOfPoints);
+  this->ParallelFor(numberOfPoints, [&](std::size_t first, std::size_t last) {
+    for (std::size_t k = first; k < last; ++k)
     {
-      v = rank[v];
+      std::copy(m_X.data() + 3 * static_cast<std::size_t>(order[k]),
+                m_X.data() + 3 * static_cast<std::size_t>(order[k]) + 3,
+                x.data() + 3 * k);
     }
+  });
+  m_X.swap(x);
+  // The triangles by their smallest new point (a stable counting sort), as
+  // Compact() orders them: in the table's old order they would be read at
+  // random by a scan in the new numbering.
+  const std::size_t        numberOfTriangles = numberOfCorners / 3;
+  std::vector<IndexType> & key = m_TriangleKey;
+  key.resize(numberOfTriangles);
+  this->ParallelFor(numberOfTriangles, [&](std::size_t first, std::size_t last) {
+    for (std::size_t t = first; t < last; ++t)
+    {
+      const std::size_t c = 3 * t;
+      key[t] = std::min({ rank[m_V[c]], rank[m_V[c + 1]], rank[m_V[c + 2]] });
+    }
+  });
+  std::vector<IndexType> & start = m_Start;
+  start.assign(numberOfPoints + 1, 0);
+  for (const IndexType k : key)
+  {
+    ++start[k + 1];
   }
+  for (std::size_t i = 0; i < numberOfPoints; ++i)
+  {
+    start[i + 1] += start[i];
+  }
+  std::vector<IndexType> & newTriangle = m_Root;
+  newTriangle.resize(numberOfTriangles);
+  for (std::size_t t = 0; t < numberOfTriangles; ++t)
+  {
+    newTriangle[t] = start[key[t]]++;
+  }
+  std::vector<Link> & opposite = m_ScratchO;
+  opposite.resize(numberOfCorners);
+  this->ParallelFor(numberOfCorners, [&](std::size_t first, std::size_t last) {
+    for (std::size_t c = first; c < last; ++c)
+    {
+      const std::size_t nc = 3 * static_cast<std::size_t>(newTriangle[c / 3]) + c % 3;
+      triangles[nc] = rank[m_V[c]];
+      const Link o = m_O[c];
+      opposite[nc] =
+        o < 0 ? o
+              : static_cast<Link>(3 * newTriangle[static_cast<std::size_t>(o) / 3] + static_cast<std::size_t>(o) % 3);
+    }
+  });
+  m_V.assign(triangles.begin(), triangles.end());
+  m_O.swap(opposite);
+  // As Build() sets it: the first corner of each point.
+  m_VertexCorner.assign(numberOfPoints, Invalid);
+  for (std::size_t c = numberOfCorners; c-- > 0;)
+  {
+    m_VertexCorner[m_V[c]] = static_cast<IndexType>(c);
+  }
+  return true;
 }
 
 inline bool
@@ -2642,8 +2748,8 @@ DeformableMeshRemesher::IsOutputClosed() const
   return closed;
 }
 
-inline std::vector<DeformableMeshRemesher::IndexType>
-DeformableMeshRemesher::LocalityOrder(const double * coordinates, std::size_t numberOfPoints)
+inline std::vector<uint64_t>
+DeformableMeshRemesher::MortonKeys(const double * coordinates, std::size_t numberOfPoints)
 {
   double lower[3] = { std::numeric_limits<double>::max(),
                       std::numeric_limits<double>::max(),
@@ -2683,7 +2789,14 @@ DeformableMeshRemesher::LocalityOrder(const double * coordinates, std::size_t nu
     }
     keys[i] = code;
   }
-  std::vector<IndexType> order(numberOfPoints);
+  return keys;
+}
+
+inline std::vector<DeformableMeshRemesher::IndexType>
+DeformableMeshRemesher::LocalityOrder(const double * coordinates, std::size_t numberOfPoints)
+{
+  const std::vector<uint64_t> keys = MortonKeys(coordinates, numberOfPoints);
+  std::vector<IndexType>      order(numberOfPoints);
   std::iota(order.begin(), order.end(), IndexType{ 0 });
   std::stable_sort(order.begin(), order.end(), [&keys](IndexType a, IndexType b) { return keys[a] < keys[b]; });
   return order;
@@ -2715,15 +2828,65 @@ DeformableMeshRemesher::BreadthFirstOrder(const double *                coordina
       neighbours[fill[b]++] = a;
     }
   }
-  const std::vector<IndexType> starts = LocalityOrder(coordinates, numberOfPoints);
-  std::vector<uint8_t>         visited(numberOfPoints, 0);
-  std::vector<IndexType>       order;
-  order.reserve(numberOfPoints);
-  for (const IndexType start : starts)
+  return BreadthFirstWalk(coordinates, numberOfPoints, offsets, neighbours, true);
+}
+
+inline std::vector<DeformableMeshRemesher::IndexType>
+DeformableMeshRemesher::OutputBreadthFirstOrder(const double * coordinates) const
+{
+  if (!m_TableValid)
   {
+    return {};
+  }
+  // Each half-edge gives its end to its start's list; a half-edge without a
+  // twin (boundary, non-manifold) its start to its end's too. A point may be
+  // listed twice around a non-manifold edge: the walk takes it once.
+  const std::size_t      numberOfPoints = m_State.size();
+  const std::size_t      numberOfCorners = m_V.size();
+  std::vector<IndexType> offsets(numberOfPoints + 1, 0);
+  for (std::size_t c = 0; c < numberOfCorners; ++c)
+  {
+    ++offsets[m_V[c] + 1];
+    if (m_O[c] < 0)
+    {
+      ++offsets[m_V[Next(static_cast<IndexType>(c))] + 1];
+    }
+  }
+  for (std::size_t i = 0; i < numberOfPoints; ++i)
+  {
+    offsets[i + 1] += offsets[i];
+  }
+  std::vector<IndexType> neighbours(offsets[numberOfPoints]);
+  {
+    std::vector<IndexType> fill(offsets.begin(), offsets.end() - 1);
+    for (std::size_t c = 0; c < numberOfCorners; ++c)
+    {
+      const IndexType a = m_V[c];
+      const IndexType b = m_V[Next(static_cast<IndexType>(c))];
+      neighbours[fill[a]++] = b;
+      if (m_O[c] < 0)
+      {
+        neighbours[fill[b]++] = a;
+      }
+    }
+  }
+  return BreadthFirstWalk(coordinates, numberOfPoints, offsets, neighbours, false);
+}
+
+inline std::vector<DeformableMeshRemesher::IndexType>
+DeformableMeshRemesher::BreadthFirstWalk(const double *                 coordinates,
+                                         std::size_t                    numberOfPoints,
+                                         const std::vector<IndexType> & offsets,
+                                         const std::vector<IndexType> & neighbours,
+                                         bool                           morton)
+{
+  std::vector<uint8_t>   visited(numberOfPoints, 0);
+  std::vector<IndexType> order;
+  order.reserve(numberOfPoints);
+  const auto walk = [&](IndexType start) {
     if (visited[start])
     {
-      continue;
+      return;
     }
     visited[start] = 1;
     std::size_t head = order.size();
@@ -2740,6 +2903,71 @@ DeformableMeshRemesher::BreadthFirstOrder(const double *                coordina
           order.push_back(w);
         }
       }
+    }
+  };
+  if (numberOfPoints == 0)
+  {
+    return order;
+  }
+  if (!morton)
+  {
+    // From the point of smallest coordinate along the longest side of the
+    // bounding box (an end of an elongated surface: short rings), then the
+    // other parts from their points of smallest number.
+    double         lower[3];
+    double         upper[3];
+    IndexType      lowest[3] = { 0, 0, 0 };
+    const double * p = coordinates;
+    for (unsigned int d = 0; d < 3; ++d)
+    {
+      lower[d] = upper[d] = p[d];
+    }
+    for (std::size_t i = 1; i < numberOfPoints; ++i)
+    {
+      p = coordinates + 3 * i;
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        if (p[d] < lower[d])
+        {
+          lower[d] = p[d];
+          lowest[d] = static_cast<IndexType>(i);
+        }
+        upper[d] = std::max(upper[d], p[d]);
+      }
+    }
+    unsigned int axis = 0;
+    for (unsigned int d = 1; d < 3; ++d)
+    {
+      axis = upper[d] - lower[d] > upper[axis] - lower[axis] ? d : axis;
+    }
+    walk(lowest[axis]);
+    for (std::size_t i = 0; i < numberOfPoints; ++i)
+    {
+      walk(static_cast<IndexType>(i));
+    }
+    return order;
+  }
+  // The parts in the order of their first point in LocalityOrder(): the
+  // first point of that order (smallest key, then smallest number), then,
+  // when points remain (more than one part), the remaining ones sorted.
+  // Usually one part: no sort of all the points.
+  const std::vector<uint64_t> keys = MortonKeys(coordinates, numberOfPoints);
+  walk(static_cast<IndexType>(std::min_element(keys.begin(), keys.end()) - keys.begin()));
+  if (order.size() < numberOfPoints)
+  {
+    std::vector<IndexType> starts;
+    starts.reserve(numberOfPoints - order.size());
+    for (std::size_t i = 0; i < numberOfPoints; ++i)
+    {
+      if (!visited[i])
+      {
+        starts.push_back(static_cast<IndexType>(i));
+      }
+    }
+    std::stable_sort(starts.begin(), starts.end(), [&keys](IndexType a, IndexType b) { return keys[a] < keys[b]; });
+    for (const IndexType start : starts)
+    {
+      walk(start);
     }
   }
   return order;

@@ -36,6 +36,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <numeric>
 #include <sstream>
 #include <set>
 #include <utility>
@@ -453,6 +454,104 @@ TEST(DeformableMeshRemesher, KeptTableGivesTheSameMeshAsAFreshOne)
   EXPECT_EQ(kept.Points(), before.Points());
   EXPECT_NE(kept.x, before.x) << "the relaxation moved points";
   EXPECT_GT(statistics.relaxed, 0u);
+}
+
+TEST(DeformableMeshRemesher, RenumberedOutputKeepsItsTable)
+{
+  // Each round: Remesh(), then the output renumbered breadth-first
+  // (OutputBreadthFirstOrder(), RenumberOutput()), then stretched. The
+  // renumbered triangles are the output's, renumbered, in the order of
+  // their smallest point; the kept table describes them as a table built
+  // from them would: the next Remesh() gives, bit for bit, what a remesher
+  // that builds its table gives.
+  PointType centre;
+  centre.Fill(0.0);
+  FlatMesh                    kept = ToFlat(itk::MakeSphereMesh<MeshType>(centre, 10.0, 3));
+  itk::DeformableMeshRemesher keeping;
+  keeping.SetTargetEdgeLength(1.5);
+  for (int round = 0; round < 8; ++round)
+  {
+    if (round > 0)
+    {
+      FlatMesh                    fresh = kept;
+      itk::DeformableMeshRemesher building;
+      building.SetTargetEdgeLength(1.5);
+      keeping.Remesh(kept.x, kept.Points(), kept.triangles);
+      building.Remesh(fresh.x, fresh.Points(), fresh.triangles);
+      ASSERT_EQ(kept.triangles, fresh.triangles) << "round " << round;
+      ASSERT_EQ(kept.x, fresh.x) << "round " << round;
+      ASSERT_EQ(keeping.Parents(), building.Parents()) << "round " << round;
+    }
+    else
+    {
+      keeping.Remesh(kept.x, kept.Points(), kept.triangles);
+    }
+    const std::vector<IndexType> order = keeping.OutputBreadthFirstOrder(kept.x.data());
+    ASSERT_EQ(order.size(), kept.Points());
+    std::vector<IndexType> rank(order.size(), std::numeric_limits<IndexType>::max());
+    for (std::size_t k = 0; k < order.size(); ++k)
+    {
+      ASSERT_EQ(rank[order[k]], std::numeric_limits<IndexType>::max()) << "a permutation";
+      rank[order[k]] = static_cast<IndexType>(k);
+    }
+    // Breadth-first from the point of smallest z (the sphere, stretched
+    // along z, is longest along z): each point after the first is a
+    // neighbour of one numbered before it.
+    if (round > 0)
+    {
+      for (std::size_t i = 0; i < kept.Points(); ++i)
+      {
+        ASSERT_GE(kept.x[3 * i + 2], kept.x[3 * order[0] + 2]);
+      }
+    }
+    std::vector<IndexType> earliest(order.size(), std::numeric_limits<IndexType>::max());
+    const auto             expected = [&rank](const std::vector<IndexType> & triangles) {
+      std::vector<std::array<IndexType, 3>> triples;
+      for (std::size_t t = 0; t < triangles.size() / 3; ++t)
+      {
+        std::array<IndexType, 3> v{
+          { rank[triangles[3 * t]], rank[triangles[3 * t + 1]], rank[triangles[3 * t + 2]] }
+        };
+        std::rotate(v.begin(), std::min_element(v.begin(), v.end()), v.end()); // orientation kept
+        triples.push_back(v);
+      }
+      std::sort(triples.begin(), triples.end());
+      return triples;
+    };
+    const auto                before = expected(kept.triangles);
+    const std::vector<double> x = kept.x;
+    ASSERT_TRUE(keeping.RenumberOutput(order, kept.triangles)) << "round " << round;
+    for (std::size_t k = 0; k < order.size(); ++k)
+    {
+      std::copy(x.begin() + 3 * order[k], x.begin() + 3 * order[k] + 3, kept.x.begin() + 3 * k);
+    }
+    std::iota(rank.begin(), rank.end(), IndexType{ 0 });
+    EXPECT_EQ(expected(kept.triangles), before) << "round " << round;
+    IndexType previous = 0;
+    for (std::size_t t = 0; t < kept.triangles.size() / 3; ++t)
+    {
+      const IndexType * v = kept.triangles.data() + 3 * t;
+      const IndexType   smallest = std::min({ v[0], v[1], v[2] });
+      ASSERT_GE(smallest, previous) << "round " << round << ", triangle " << t;
+      previous = smallest;
+      for (unsigned int k = 0; k < 3; ++k)
+      {
+        earliest[v[k]] = std::min({ earliest[v[k]], v[0], v[1], v[2] });
+      }
+    }
+    for (std::size_t k = 1; k < earliest.size(); ++k)
+    {
+      ASSERT_LT(earliest[k], k) << "round " << round << ": point " << k << " has no neighbour numbered before it";
+    }
+    // Not the output's triangles: refused, and nothing changes.
+    std::vector<IndexType> other = kept.triangles;
+    std::swap(other[0], other[1]);
+    EXPECT_THROW(keeping.RenumberOutput(order, other), itk::ExceptionObject);
+    for (std::size_t i = 0; i < kept.Points(); ++i)
+    {
+      kept.x[3 * i + 2] *= 1.04;
+    }
+  }
 }
 
 TEST(DeformableMeshRemesher, IncrementalRemeshingMovesNothingFarFromItsOperations)
