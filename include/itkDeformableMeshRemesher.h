@@ -331,22 +331,6 @@ public:
   static std::vector<IndexType>
   LocalityOrder(const double * coordinates, std::size_t numberOfPoints);
 
-  /** The Morton codes of LocalityOrder(): the 21-bit grid coordinates of
-   * each point over the bounding box, interleaved. */
-  static std::vector<uint64_t>
-  MortonKeys(const double * coordinates, std::size_t numberOfPoints);
-
-  /** The breadth-first walk over the neighbour lists \a neighbours[offsets[v]]
-   * to neighbours[offsets[v + 1]] of each point v: with \a morton, each
-   * connected part from its first point in LocalityOrder()
-   * (BreadthFirstOrder()); without, as OutputBreadthFirstOrder() says. */
-  static std::vector<IndexType>
-  BreadthFirstWalk(const double *                 coordinates,
-                   std::size_t                    numberOfPoints,
-                   const std::vector<IndexType> & offsets,
-                   const std::vector<IndexType> & neighbours,
-                   bool                           morton);
-
   /** A renumbering for locality that follows the surface: a breadth-first
    * walk over the \a edges ((min << 32 | max) of their end-points), from
    * the point first in LocalityOrder() of each connected part. The points
@@ -373,6 +357,22 @@ public:
   FarEdgeFraction(const std::vector<IndexType> & triangles, std::size_t window);
 
 private:
+  /** The Morton codes of LocalityOrder(): the 21-bit grid coordinates of
+   * each point over the bounding box, interleaved. */
+  static std::vector<uint64_t>
+  MortonKeys(const double * coordinates, std::size_t numberOfPoints);
+
+  /** The breadth-first walk over the neighbour lists \a neighbours[offsets[v]]
+   * to neighbours[offsets[v + 1]] of each point v: with \a morton, each
+   * connected part from its first point in LocalityOrder()
+   * (BreadthFirstOrder()); without, as OutputBreadthFirstOrder() says. */
+  static std::vector<IndexType>
+  BreadthFirstWalk(const double *                 coordinates,
+                   std::size_t                    numberOfPoints,
+                   const std::vector<IndexType> & offsets,
+                   const std::vector<IndexType> & neighbours,
+                   bool                           morton);
+
   static constexpr IndexType Invalid = std::numeric_limits<IndexType>::max();
   // A corner's link to the opposite half-edge: its corner, Boundary or
   // NonManifold. 32 bits (the corner table is the remesher's largest array):
@@ -2846,6 +2846,10 @@ DeformableMeshRemesher::OutputBreadthFirstOrder(const double * coordinates) cons
   std::vector<IndexType> offsets(numberOfPoints + 1, 0);
   for (std::size_t c = 0; c < numberOfCorners; ++c)
   {
+    if (m_V[c] == Invalid)
+    {
+      return {}; // not a compacted output (cannot happen with a valid table)
+    }
     ++offsets[m_V[c] + 1];
     if (m_O[c] < 0)
     {
