@@ -1034,19 +1034,31 @@ PrintSummary()
     }
   }
   {
-    const double remesh100k = Rate("BM_EDM_Remeshing/vertices:100000/real_time");
-    const double remesh1M = Rate("BM_EDM_Remeshing/vertices:1000000/real_time");
     const double renumbered = Rate("BM_EDM_RegularSphereSource/renumber:1/real_time");
     const double asInput = Rate("BM_EDM_RegularSphereSource/renumber:0/real_time");
-    if (remesh100k + remesh1M > 0.0)
-    {
-      std::printf("remeshing every 10 iterations, 2 threads: 100000 vertices %.2f M, 1000000 vertices %.2f M "
-                  "vertex-iterations/s (issue 15 target: 25 M); CPU time per vertex-iteration %.0f ns and %.0f ns\n",
-                  remesh100k * 1e-6,
-                  remesh1M * 1e-6,
-                  CPUTime("BM_EDM_Remeshing/vertices:100000/real_time"),
-                  CPUTime("BM_EDM_Remeshing/vertices:1000000/real_time"));
-    }
+    // The remeshing rows, with the whole force (suppress_drift:0) and with
+    // SuppressTangentialDrift (suppress_drift:1).
+    const auto remeshingSummary = [](const char * benchmark, const char * what) {
+      for (const char * drift : { "0", "1" })
+      {
+        const std::string row100k = std::string(benchmark) + "/vertices:100000/suppress_drift:" + drift + "/real_time";
+        const std::string row1M = std::string(benchmark) + "/vertices:1000000/suppress_drift:" + drift + "/real_time";
+        const double      rate100k = Rate(row100k);
+        const double      rate1M = Rate(row1M);
+        if (rate100k + rate1M > 0.0)
+        {
+          std::printf("%s%s, 2 threads: 100000 vertices %.2f M, 1000000 vertices %.2f M vertex-iterations/s (issue "
+                      "15 target: 25 M); CPU time per vertex-iteration %.0f ns and %.0f ns\n",
+                      what,
+                      drift[0] == '1' ? ", SuppressTangentialDrift" : "",
+                      rate100k * 1e-6,
+                      rate1M * 1e-6,
+                      CPUTime(row100k),
+                      CPUTime(row1M));
+        }
+      }
+    };
+    remeshingSummary("BM_EDM_Remeshing", "remeshing every 10 iterations");
     const double collision100k = Rate("BM_EDM_SelfIntersection/vertices:100000/threads:2/real_time");
     const double collision1M = Rate("BM_EDM_SelfIntersection/vertices:1000000/threads:2/real_time");
     if (collision100k + collision1M > 0.0)
@@ -1058,18 +1070,8 @@ PrintSummary()
                   CPUTime("BM_EDM_SelfIntersection/vertices:100000/threads:2/real_time"),
                   CPUTime("BM_EDM_SelfIntersection/vertices:1000000/threads:2/real_time"));
     }
-    const double combined100k = Rate("BM_EDM_CollisionsAndRemeshing/vertices:100000/real_time");
-    const double combined1M = Rate("BM_EDM_CollisionsAndRemeshing/vertices:1000000/real_time");
-    if (combined100k + combined1M > 0.0)
-    {
-      std::printf("remeshing every 10 iterations with the collision test every iteration, 2 threads: 100000 vertices "
-                  "%.2f M, 1000000 vertices %.2f M vertex-iterations/s (issue 15 target: 25 M); CPU time per "
-                  "vertex-iteration %.0f ns and %.0f ns\n",
-                  combined100k * 1e-6,
-                  combined1M * 1e-6,
-                  CPUTime("BM_EDM_CollisionsAndRemeshing/vertices:100000/real_time"),
-                  CPUTime("BM_EDM_CollisionsAndRemeshing/vertices:1000000/real_time"));
-    }
+    remeshingSummary("BM_EDM_CollisionsAndRemeshing",
+                     "remeshing every 10 iterations with the collision test every iteration");
     if (renumbered + asInput > 0.0)
     {
       std::printf("RegularSphereMeshSource, 262146 vertices, 2 threads: renumbered %.2f M, input numbering %.2f M "
