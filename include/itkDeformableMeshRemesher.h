@@ -619,6 +619,16 @@ private:
   RequeueFan(SweepWorker & worker, IndexType v);
   void
   Compact(std::vector<double> & coordinates, std::vector<IndexType> & triangles);
+  /** The table in a new numbering of its points (\a newIndex, Invalid for
+   * removed points, \a newPoints in all): the triangles left, ordered by
+   * their smallest new point (a stable counting sort), written to \a
+   * triangles and to the table. False when a corner's twin was removed
+   * without it (the table then does not describe the triangles). */
+  bool
+  ReorderTable(const std::vector<IndexType> & newIndex, std::size_t newPoints, std::vector<IndexType> & triangles);
+  /** m_VertexCorner as Build() sets it: the first corner of each point. */
+  void
+  SetFirstCorners();
 
   MultiThreaderBase * m_Threader{ nullptr };
   unsigned int        m_WorkUnits{ 1 };
@@ -2247,7 +2257,6 @@ inline void
 DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<IndexType> & triangles)
 {
   const std::size_t numberOfPoints = m_State.size();
-  const std::size_t numberOfCorners = m_V.size();
   const bool        removed =
     m_Statistics.collapses > 0 || std::find(m_State.begin(), m_State.end(), RemesherRemoved) != m_State.end();
   if (numberOfPoints == m_InputPoints && !removed)
@@ -2322,90 +2331,105 @@ DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<I
     m_Touched.swap(touched);
     m_Valence.swap(valence);
 
-    // The corner table in the new numbering: the remaining triangles
-    // ordered by their smallest new vertex (a stable counting sort), so that
-    // the corners of a fan sit near each other in memory as the vertices
-    // do. In the order of the table, the triangles that splits appended
-    // would lie far from their neighbours, in the order of their edge
-    // lengths.
-    std::vector<IndexType> & newCorner = m_NewCorner;
-    newCorner.resize(numberOfCorners);
-    // The keys in parallel (three reads of the new numbers each); the
-    // counting sort itself reads them in order.
-    const std::size_t        numberOfTriangles = numberOfCorners / 3;
-    std::vector<IndexType> & key = m_TriangleKey;
-    key.resize(numberOfTriangles);
-    this->ParallelFor(numberOfTriangles, [&](std::size_t first, std::size_t last) {
-      for (std::size_t t = first; t < last; ++t)
-      {
-        const std::size_t c = 3 * t;
-        key[t] =
-          m_V[c] == Invalid ? Invalid : std::min({ newIndex[m_V[c]], newIndex[m_V[c + 1]], newIndex[m_V[c + 2]] });
-      }
-    });
-    start.assign(static_cast<std::size_t>(kept) + 1, 0);
-    for (const IndexType k : key)
-    {
-      if (k != Invalid)
-      {
-        ++start[k + 1];
-      }
-    }
-    for (std::size_t i = 0; i < kept; ++i)
-    {
-      start[i + 1] += start[i];
-    }
-    const IndexType next = 3 * start[kept];
-    for (std::size_t t = 0; t < numberOfTriangles; ++t)
-    {
-      const IndexType k = key[t];
-      const IndexType nt = k != Invalid ? 3 * start[k]++ : Invalid;
-      newCorner[3 * t] = nt;
-      newCorner[3 * t + 1] = k != Invalid ? nt + 1 : Invalid;
-      newCorner[3 * t + 2] = k != Invalid ? nt + 2 : Invalid;
-    }
-    triangles.resize(next);
-    std::vector<Link> & opposite = m_ScratchO;
-    opposite.resize(next);
-    std::atomic<bool> consistent{ true };
-    this->ParallelFor(numberOfCorners, [&](std::size_t first, std::size_t last) {
-      bool consistentHere = true;
-      for (std::size_t c = first; c < last; ++c)
-      {
-        const IndexType nc = newCorner[c];
-        if (nc == Invalid)
-        {
-          continue;
-        }
-        triangles[nc] = newIndex[m_V[c]];
-        const Link o = m_O[c];
-        if (o < 0)
-        {
-          opposite[nc] = o;
-        }
-        else
-        {
-          const IndexType no = newCorner[static_cast<std::size_t>(o)];
-          consistentHere = consistentHere && no != Invalid;
-          opposite[nc] = no != Invalid ? static_cast<Link>(no) : NonManifold;
-        }
-      }
-      if (!consistentHere)
-      {
-        consistent = false;
-      }
-    });
-    m_V.assign(triangles.begin(), triangles.end());
-    m_O.swap(opposite);
     // A table that does not describe the output is built again next time.
-    m_TableValid = consistent;
+    m_TableValid = this->ReorderTable(newIndex, kept, triangles);
   }
+  this->SetFirstCorners();
+}
+
+inline void
+DeformableMeshRemesher::SetFirstCorners()
+{
   // As Build() sets it: the first corner of each vertex.
   m_VertexCorner.assign(m_State.size(), Invalid);
   for (std::size_t c = m_V.size(); c-- > 0;)
   {
     m_VertexCorner[m_V[c]] = static_cast<IndexType>(c);
   }
+}
+
+inline bool
+DeformableMeshRemesher::ReorderTable(const std::vector<IndexType> & newIndex,
+                                     std::size_t                    newPoints,
+                                     std::vector<IndexType> &       triangles)
+{
+  const std::size_t numberOfCorners = m_V.size();
+  // The corner table in the new numbering: the remaining triangles
+  // ordered by their smallest new vertex (a stable counting sort), so that
+  // the corners of a fan sit near each other in memory as the vertices
+  // do. In the order of the table, the triangles that splits appended
+  // would lie far from their neighbours, in the order of their edge
+  // lengths.
+  std::vector<IndexType> & newCorner = m_NewCorner;
+  newCorner.resize(numberOfCorners);
+  // The keys in parallel (three reads of the new numbers each); the
+  // counting sort itself reads them in order.
+  const std::size_t        numberOfTriangles = numberOfCorners / 3;
+  std::vector<IndexType> & key = m_TriangleKey;
+  key.resize(numberOfTriangles);
+  this->ParallelFor(numberOfTriangles, [&](std::size_t first, std::size_t last) {
+    for (std::size_t t = first; t < last; ++t)
+    {
+      const std::size_t c = 3 * t;
+      key[t] = m_V[c] == Invalid ? Invalid : std::min({ newIndex[m_V[c]], newIndex[m_V[c + 1]], newIndex[m_V[c + 2]] });
+    }
+  });
+  std::vector<IndexType> & start = m_Start;
+  start.assign(newPoints + 1, 0);
+  for (const IndexType k : key)
+  {
+    if (k != Invalid)
+    {
+      ++start[k + 1];
+    }
+  }
+  for (std::size_t i = 0; i < newPoints; ++i)
+  {
+    start[i + 1] += start[i];
+  }
+  const IndexType next = 3 * start[newPoints];
+  for (std::size_t t = 0; t < numberOfTriangles; ++t)
+  {
+    const IndexType k = key[t];
+    const IndexType nt = k != Invalid ? 3 * start[k]++ : Invalid;
+    newCorner[3 * t] = nt;
+    newCorner[3 * t + 1] = k != Invalid ? nt + 1 : Invalid;
+    newCorner[3 * t + 2] = k != Invalid ? nt + 2 : Invalid;
+  }
+  triangles.resize(next);
+  std::vector<Link> & opposite = m_ScratchO;
+  opposite.resize(next);
+  std::atomic<bool> consistent{ true };
+  this->ParallelFor(numberOfCorners, [&](std::size_t first, std::size_t last) {
+    bool consistentHere = true;
+    for (std::size_t c = first; c < last; ++c)
+    {
+      const IndexType nc = newCorner[c];
+      if (nc == Invalid)
+      {
+        continue;
+      }
+      triangles[nc] = newIndex[m_V[c]];
+      const Link o = m_O[c];
+      if (o < 0)
+      {
+        opposite[nc] = o;
+      }
+      else
+      {
+        const IndexType no = newCorner[static_cast<std::size_t>(o)];
+        consistentHere = consistentHere && no != Invalid;
+        opposite[nc] = no != Invalid ? static_cast<Link>(no) : NonManifold;
+      }
+    }
+    if (!consistentHere)
+    {
+      consistent = false;
+    }
+  });
+  m_V.assign(triangles.begin(), triangles.end());
+  m_O.swap(opposite);
+  return consistent;
 }
 
 inline bool
@@ -2476,56 +2500,11 @@ DeformableMeshRemesher::RenumberOutput(const std::vector<IndexType> & order, std
     }
   });
   m_X.swap(x);
-  // The triangles by their smallest new point (a stable counting sort), as
-  // Compact() orders them: in the table's old order they would be read at
-  // random by a scan in the new numbering.
-  const std::size_t        numberOfTriangles = numberOfCorners / 3;
-  std::vector<IndexType> & key = m_TriangleKey;
-  key.resize(numberOfTriangles);
-  this->ParallelFor(numberOfTriangles, [&](std::size_t first, std::size_t last) {
-    for (std::size_t t = first; t < last; ++t)
-    {
-      const std::size_t c = 3 * t;
-      key[t] = std::min({ rank[m_V[c]], rank[m_V[c + 1]], rank[m_V[c + 2]] });
-    }
-  });
-  std::vector<IndexType> & start = m_Start;
-  start.assign(numberOfPoints + 1, 0);
-  for (const IndexType k : key)
-  {
-    ++start[k + 1];
-  }
-  for (std::size_t i = 0; i < numberOfPoints; ++i)
-  {
-    start[i + 1] += start[i];
-  }
-  std::vector<IndexType> & newTriangle = m_Root;
-  newTriangle.resize(numberOfTriangles);
-  for (std::size_t t = 0; t < numberOfTriangles; ++t)
-  {
-    newTriangle[t] = start[key[t]]++;
-  }
-  std::vector<Link> & opposite = m_ScratchO;
-  opposite.resize(numberOfCorners);
-  this->ParallelFor(numberOfCorners, [&](std::size_t first, std::size_t last) {
-    for (std::size_t c = first; c < last; ++c)
-    {
-      const std::size_t nc = 3 * static_cast<std::size_t>(newTriangle[c / 3]) + c % 3;
-      triangles[nc] = rank[m_V[c]];
-      const Link o = m_O[c];
-      opposite[nc] =
-        o < 0 ? o
-              : static_cast<Link>(3 * newTriangle[static_cast<std::size_t>(o) / 3] + static_cast<std::size_t>(o) % 3);
-    }
-  });
-  m_V.assign(triangles.begin(), triangles.end());
-  m_O.swap(opposite);
-  // As Build() sets it: the first corner of each point.
-  m_VertexCorner.assign(numberOfPoints, Invalid);
-  for (std::size_t c = numberOfCorners; c-- > 0;)
-  {
-    m_VertexCorner[m_V[c]] = static_cast<IndexType>(c);
-  }
+  // The triangles by their smallest new point, as Compact() orders them: in
+  // the table's old order they would be read at random by a scan in the new
+  // numbering.
+  this->ReorderTable(rank, numberOfPoints, triangles);
+  this->SetFirstCorners();
   return true;
 }
 
