@@ -1789,7 +1789,22 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
   {
     const std::vector<IndexType32> & parents = m_Remesher.Parents();
     const SizeValueType              remeshedTriangles = m_Triangles.size() / 3;
-    const auto                       moved = [&](IndexType32 v) {
+    // The collision test's surface and index for the remeshed mesh, built
+    // at its positions: the next step keeps the index. A surface that the
+    // star-shaped certificate accepts has no contact: the flags below, which
+    // say which pairs count, are then not needed.
+    m_Collision.SetSurface(parents.size(),
+                           m_Triangles.data(),
+                           remeshedTriangles,
+                           this->GetMultiThreader(),
+                           this->GetNumberOfWorkUnits(),
+                           m_Remesher.IsOutputClosed());
+    if (m_Collision.CertifyContacts(
+          x.data(), m_MinimumDistance, this->GetMultiThreader(), this->GetNumberOfWorkUnits()))
+    {
+      break;
+    }
+    const auto moved = [&](IndexType32 v) {
       const IndexType32 p = parents[v];
       return x[3 * v] != before[3 * p] || x[3 * v + 1] != before[3 * p + 1] || x[3 * v + 2] != before[3 * p + 2];
     };
@@ -1910,16 +1925,13 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
         }
       }
     }
-    // The collision test's surface and index for the remeshed mesh, built
-    // at its positions: the next step keeps the index.
-    m_Collision.SetSurface(parents.size(),
-                           m_Triangles.data(),
-                           remeshedTriangles,
-                           this->GetMultiThreader(),
-                           this->GetNumberOfWorkUnits(),
-                           m_Remesher.IsOutputClosed());
-    const SizeValueType found = m_Collision.FindContacts(
-      x.data(), changed.data(), m_MinimumDistance, contacts, this->GetMultiThreader(), this->GetNumberOfWorkUnits());
+    const SizeValueType found = m_Collision.FindContacts(x.data(),
+                                                         changed.data(),
+                                                         m_MinimumDistance,
+                                                         contacts,
+                                                         this->GetMultiThreader(),
+                                                         this->GetNumberOfWorkUnits(),
+                                                         false);
     if (found == 0)
     {
       break;

@@ -1657,14 +1657,17 @@ public:
    * \a contacts (resized to the number of triangles) and returns the number
    * of pairs. The index's candidate pairs hold every pair closer than its
    * radius with a lower bound of its distance, so only pairs near contact
-   * are measured exactly. 0 and no flag when a coordinate is not finite. */
+   * are measured exactly. 0 and no flag when a coordinate is not finite.
+   * With \a tryCertificate false the star-shaped certificate is not tried
+   * (CertifyContacts() was, and did not accept \a x). */
   SizeValueType
   FindContacts(const double *         x,
                const uint8_t *        changed,
                double                 minimumDistance,
                std::vector<uint8_t> & contacts,
                MultiThreaderBase *    threader,
-               unsigned int           workUnits)
+               unsigned int           workUnits,
+               bool                   tryCertificate = true)
   {
     const SizeValueType numberOfTriangles = this->GetNumberOfTriangles();
     contacts.assign(numberOfTriangles, 0);
@@ -1677,7 +1680,7 @@ public:
       m_Level.assign(m_NumberOfPoints, 0);
     }
     const SurfaceCollisionDetail::ParallelBlocks parallel{ threader, workUnits };
-    if (this->Certify(x, minimumDistance, parallel))
+    if (tryCertificate && this->Certify(x, minimumDistance, parallel))
     {
       return 0;
     }
@@ -1738,6 +1741,25 @@ public:
       }
     }
     return count;
+  }
+
+  /** FindContacts()'s first test alone: true when the star-shaped
+   * certificate (class documentation) accepts the positions \a x at
+   * \a minimumDistance, so that no pair is in contact (FindContacts() would
+   * return 0), the certificate then kept as FindContacts() keeps it. For a
+   * caller whose flags of changed triangles cost passes to make: it makes
+   * them only when this returns false, then calls FindContacts() with
+   * tryCertificate false. False also when the certificate does not apply
+   * (an open surface, a minimum distance above 0, a wait after a failure). */
+  bool
+  CertifyContacts(const double * x, double minimumDistance, MultiThreaderBase * threader, unsigned int workUnits)
+  {
+    if (m_NumberOfPoints == 0 || this->GetNumberOfTriangles() < 2)
+    {
+      return false;
+    }
+    const SurfaceCollisionDetail::ParallelBlocks parallel{ threader, workUnits };
+    return this->Certify(x, minimumDistance, parallel);
   }
 
   /** Modifies the proposed positions \a y (3 doubles a point) so that no
