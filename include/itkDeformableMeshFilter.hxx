@@ -1682,10 +1682,13 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
   remap(m_DisplacementMagnitudes);
   remap(m_ExternalForceMagnitudes);
   remap(m_InternalForceMagnitudes);
-  std::vector<float>().swap(m_Umbrella);
-  std::vector<float>().swap(m_Normals);
-  std::vector<float>().swap(m_NormalSpeeds);
-  std::vector<float>().swap(m_EdgeHits);
+  // Sized again (and filled) at the next iteration; their memory is kept:
+  // freed here, it came back as new pages to fault in and clear at every
+  // remeshing (32 MB at a million points).
+  m_Umbrella.clear();
+  m_Normals.clear();
+  m_NormalSpeeds.clear();
+  m_EdgeHits.clear();
 
   this->SetCachedTriangles(newNumberOfPoints, m_Triangles);
   if (!this->BuildTopologyFromRemesher())
