@@ -1402,6 +1402,48 @@ TEST(SurfaceCollision, AfterAFailureTheCertificateWaitsLongerEachTime)
   EXPECT_EQ(contacts.size(), triangles.size() / 3);
 }
 
+TEST(SurfaceCollision, CertifyContactsIsFindContactsFirstTest)
+{
+  // CertifyContacts() answers as FindContacts()'s certificate: true on a
+  // star-shaped surface at distance 0 (counted as a certified step), false
+  // where the certificate does not apply (a minimum distance above 0) or
+  // refuses (a point pushed through the surface); FindContacts() told not to
+  // try it again then finds the contacts with the index, without a
+  // certified step.
+  std::vector<double>   x;
+  std::vector<uint32_t> triangles;
+  StarSphere(x, triangles);
+  const itk::SizeValueType numberOfTriangles = triangles.size() / 3;
+  itk::SurfaceCollision    collision;
+  collision.SetSurface(x.size() / 3, triangles.data(), numberOfTriangles);
+  itk::SizeValueType certified = collision.GetNumberOfCertifiedSteps();
+  EXPECT_TRUE(collision.CertifyContacts(x.data(), 0.0, nullptr, 1));
+  EXPECT_EQ(collision.GetNumberOfCertifiedSteps(), certified + 1);
+  certified = collision.GetNumberOfCertifiedSteps();
+  EXPECT_FALSE(collision.CertifyContacts(x.data(), 0.5, nullptr, 1)) << "no certificate above distance 0";
+  EXPECT_EQ(collision.GetNumberOfCertifiedSteps(), certified);
+
+  const std::vector<double> through = PushedThrough(x);
+  const itk::SizeValueType  intersecting = CheckAllPairs(through, triangles, 0.0).intersecting;
+  ASSERT_GT(intersecting, 0u);
+  itk::SurfaceCollision pushed;
+  pushed.SetSurface(x.size() / 3, triangles.data(), numberOfTriangles);
+  EXPECT_FALSE(pushed.CertifyContacts(through.data(), 0.0, nullptr, 1));
+  std::vector<uint8_t> contacts;
+  EXPECT_GE(pushed.FindContacts(through.data(), nullptr, 0.0, contacts, nullptr, 1, false), intersecting);
+  EXPECT_EQ(pushed.GetNumberOfCertifiedSteps(), 0u);
+  ASSERT_EQ(contacts.size(), numberOfTriangles);
+  EXPECT_GT(std::count(contacts.begin(), contacts.end(), uint8_t{ 1 }), 0);
+  // The same surface from a fresh collision test, certificate allowed:
+  // the same number of pairs.
+  itk::SurfaceCollision fresh;
+  fresh.SetSurface(x.size() / 3, triangles.data(), numberOfTriangles);
+  std::vector<uint8_t> freshContacts;
+  EXPECT_EQ(fresh.FindContacts(through.data(), nullptr, 0.0, freshContacts, nullptr, 1),
+            pushed.FindContacts(through.data(), nullptr, 0.0, contacts, nullptr, 1, false));
+  EXPECT_EQ(freshContacts, contacts);
+}
+
 namespace
 {
 /** Statistics of RandomSteps(). */
