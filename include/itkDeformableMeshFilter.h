@@ -1018,8 +1018,11 @@ private:
   SizeValueType                     m_NumberOfConstrainedVertices{ 0 };
   /** The collision test's tables and index (PreventSelfIntersections). */
   SurfaceCollision m_Collision;
-  /** The triangles last given to ResetCollision() (empty: the input's). */
+  /** The triangles last given to ResetCollision() (empty: the input's),
+   * unless m_CollisionTrianglesAreMeshTriangles: then m_Triangles (after a
+   * remeshing, whose triangles are not copied: 24 MB at a million points). */
   std::vector<uint32_t> m_CollisionTriangles;
+  bool                  m_CollisionTrianglesAreMeshTriangles{ false };
   /** Finite values and step bound of the force image (bad input). */
   ForceImageCheck<ForceImageType> m_ForceImageCheck;
 

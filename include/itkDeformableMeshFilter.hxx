@@ -927,6 +927,7 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
   {
     renumberedTriangles = triangles;
   }
+  m_CollisionTrianglesAreMeshTriangles = false;
   if (m_RemeshingEdgeLength > 0.0 && PointDimension == 3)
   {
     m_Triangles.swap(triangles);
@@ -977,13 +978,21 @@ DeformableMeshFilter<TMesh, TForceImage>::ResetCollision(const std::vector<uint3
   {
     m_TotalNumberOfCollisionsPrevented = 0;
   }
-  if (triangles == nullptr)
+  if (triangles == &m_Triangles)
+  {
+    // The remeshed triangles: kept in m_Triangles, not copied.
+    std::vector<uint32_t>().swap(m_CollisionTriangles);
+    m_CollisionTrianglesAreMeshTriangles = true;
+  }
+  else if (triangles == nullptr)
   {
     m_CollisionTriangles.clear();
+    m_CollisionTrianglesAreMeshTriangles = false;
   }
   else if (triangles != &m_CollisionTriangles)
   {
     m_CollisionTriangles = *triangles;
+    m_CollisionTrianglesAreMeshTriangles = false;
   }
   if (!m_PreventSelfIntersections)
   {
@@ -1040,7 +1049,10 @@ DeformableMeshFilter<TMesh, TForceImage>::ConstrainSelfIntersections(std::vector
   if (!m_Collision.HasSurface())
   {
     // Turned on after the last reset: set up (and check) now.
-    this->ResetCollision(m_CollisionTriangles.empty() ? nullptr : &m_CollisionTriangles, true);
+    this->ResetCollision(m_CollisionTrianglesAreMeshTriangles
+                           ? &m_Triangles
+                           : (m_CollisionTriangles.empty() ? nullptr : &m_CollisionTriangles),
+                         true);
   }
   if (m_Collision.GetNumberOfPoints() != this->GetNumberOfCachedPoints())
   {
@@ -1708,7 +1720,8 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
   // surface without one: SurfaceCollision::IsStarShaped()).
   if (m_PreventSelfIntersections && m_Collision.HasSurface() && m_Collision.GetNumberOfPoints() == newNumberOfPoints)
   {
-    m_CollisionTriangles = m_Triangles;
+    std::vector<uint32_t>().swap(m_CollisionTriangles);
+    m_CollisionTrianglesAreMeshTriangles = true;
     m_NumberOfCollisionsPrevented = 0;
     m_NumberOfConstrainedVertices = 0;
   }

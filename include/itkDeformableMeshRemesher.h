@@ -680,7 +680,8 @@ private:
   std::vector<IndexType> m_LeftShort; // m_StillShort after the first CollapsePass(), incremental
   bool                   m_TrackStillShort{ false };
   bool                   m_StillShortValid{ false };
-  std::vector<IndexType> m_NewIndex; // scratch of Compact()
+  std::vector<IndexType> m_NewIndex;    // scratch of Compact()
+  std::vector<IndexType> m_SecondStart; // scratch of ReorderTable()
   std::vector<IndexType> m_NewCorner;
   std::vector<IndexType> m_TriangleKey; // scratch of Compact()
   std::size_t            m_InputPoints{ 0 };
@@ -2288,22 +2289,33 @@ DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<I
         root[i] = r;
       }
     });
+    // A counting sort on the input ancestor: each input point kept counts
+    // one in its own group, in parallel; the points split during this
+    // remeshing (few at rest) are added to their ancestors' groups.
+    const std::size_t        inputPoints = m_InputPoints;
     std::vector<IndexType> & start = m_Start;
-    start.assign(m_InputPoints + 1, 0);
-    for (std::size_t i = 0; i < numberOfPoints; ++i)
+    start.resize(inputPoints + 1);
+    start[0] = 0;
+    this->ParallelFor(inputPoints, [&](std::size_t first, std::size_t last) {
+      for (std::size_t i = first; i < last; ++i)
+      {
+        start[i + 1] = m_State[i] != RemesherRemoved ? 1 : 0;
+      }
+    });
+    for (std::size_t i = inputPoints; i < numberOfPoints; ++i)
     {
       if (m_State[i] != RemesherRemoved)
       {
         ++start[root[i] + 1];
       }
     }
-    for (std::size_t i = 0; i < m_InputPoints; ++i)
+    for (std::size_t i = 0; i < inputPoints; ++i)
     {
       start[i + 1] += start[i];
     }
-    const IndexType          kept = start[m_InputPoints];
+    const IndexType          kept = start[inputPoints];
     std::vector<IndexType> & newIndex = m_NewIndex;
-    newIndex.assign(numberOfPoints, Invalid);
+    newIndex.resize(numberOfPoints);
     std::vector<IndexType> & parents = m_ScratchParents;
     std::vector<uint8_t> &   state = m_ScratchState;
     std::vector<uint8_t> &   touched = m_ScratchTouched;
@@ -2313,17 +2325,39 @@ DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<I
     touched.resize(kept);
     valence.resize(kept);
     coordinates.resize(3 * static_cast<std::size_t>(kept));
-    for (std::size_t i = 0; i < numberOfPoints; ++i)
+    const auto place = [&](std::size_t i, IndexType k) {
+      newIndex[i] = k;
+      parents[k] = root[i];
+      state[k] = m_State[i];
+      touched[k] = m_Touched[i];
+      valence[k] = m_Valence[i];
+      std::copy(m_X.data() + 3 * i, m_X.data() + 3 * i + 3, coordinates.data() + 3 * static_cast<std::size_t>(k));
+    };
+    // Each input point first in its group (in parallel: each touches its own
+    // group's cursor), then the split points in the order of their numbers,
+    // as a serial pass over all the points in order places them.
+    this->ParallelFor(inputPoints, [&](std::size_t first, std::size_t last) {
+      for (std::size_t i = first; i < last; ++i)
+      {
+        if (m_State[i] != RemesherRemoved)
+        {
+          place(i, start[i]++);
+        }
+        else
+        {
+          newIndex[i] = Invalid;
+        }
+      }
+    });
+    for (std::size_t i = inputPoints; i < numberOfPoints; ++i)
     {
       if (m_State[i] != RemesherRemoved)
       {
-        const IndexType k = start[root[i]]++;
-        newIndex[i] = k;
-        parents[k] = root[i];
-        state[k] = m_State[i];
-        touched[k] = m_Touched[i];
-        valence[k] = m_Valence[i];
-        std::copy(m_X.data() + 3 * i, m_X.data() + 3 * i + 3, coordinates.data() + 3 * static_cast<std::size_t>(k));
+        place(i, start[root[i]]++);
+      }
+      else
+      {
+        newIndex[i] = Invalid;
       }
     }
     m_Parents.swap(parents);
@@ -2374,28 +2408,61 @@ DeformableMeshRemesher::ReorderTable(const std::vector<IndexType> & newIndex,
       key[t] = m_V[c] == Invalid ? Invalid : std::min({ newIndex[m_V[c]], newIndex[m_V[c + 1]], newIndex[m_V[c + 2]] });
     }
   });
+  // The stable counting sort in two halves of the triangles, each counted
+  // and placed in parallel with the other: the triangles of a key from the
+  // first half, then those from the second, each half in its order (the
+  // order of a serial counting sort).
+  const std::size_t        half = numberOfTriangles / 2;
   std::vector<IndexType> & start = m_Start;
+  std::vector<IndexType> & secondStart = m_SecondStart;
   start.assign(newPoints + 1, 0);
-  for (const IndexType k : key)
-  {
-    if (k != Invalid)
+  secondStart.assign(newPoints + 1, 0);
+  const auto count = [&](std::size_t part) {
+    std::vector<IndexType> & counts = part == 0 ? start : secondStart;
+    for (std::size_t t = part == 0 ? 0 : half; t < (part == 0 ? half : numberOfTriangles); ++t)
     {
-      ++start[k + 1];
+      if (key[t] != Invalid)
+      {
+        ++counts[key[t] + 1];
+      }
     }
-  }
-  for (std::size_t i = 0; i < newPoints; ++i)
+  };
+  const auto halves = [this](auto && body) {
+    if (m_Threader == nullptr)
+    {
+      body(0);
+      body(1);
+      return;
+    }
+    m_Threader->SetNumberOfWorkUnits(2);
+    m_Threader->ParallelizeArray(
+      0, 2, [&](SizeValueType part) { body(part); }, nullptr);
+  };
+  halves(count);
+  // Per key: the first half's triangles from start[k], the second half's
+  // from secondStart[k].
+  IndexType offset = 0;
+  for (std::size_t k = 0; k < newPoints; ++k)
   {
-    start[i + 1] += start[i];
+    const IndexType first = start[k + 1];
+    const IndexType second = secondStart[k + 1];
+    start[k] = offset;
+    secondStart[k] = offset + first;
+    offset += first + second;
   }
-  const IndexType next = 3 * start[newPoints];
-  for (std::size_t t = 0; t < numberOfTriangles; ++t)
-  {
-    const IndexType k = key[t];
-    const IndexType nt = k != Invalid ? 3 * start[k]++ : Invalid;
-    newCorner[3 * t] = nt;
-    newCorner[3 * t + 1] = k != Invalid ? nt + 1 : Invalid;
-    newCorner[3 * t + 2] = k != Invalid ? nt + 2 : Invalid;
-  }
+  start[newPoints] = offset;
+  halves([&](std::size_t part) {
+    std::vector<IndexType> & cursor = part == 0 ? start : secondStart;
+    for (std::size_t t = part == 0 ? 0 : half; t < (part == 0 ? half : numberOfTriangles); ++t)
+    {
+      const IndexType k = key[t];
+      const IndexType nt = k != Invalid ? 3 * cursor[k]++ : Invalid;
+      newCorner[3 * t] = nt;
+      newCorner[3 * t + 1] = k != Invalid ? nt + 1 : Invalid;
+      newCorner[3 * t + 2] = k != Invalid ? nt + 2 : Invalid;
+    }
+  });
+  const IndexType next = 3 * offset;
   triangles.resize(next);
   std::vector<Link> & opposite = m_ScratchO;
   opposite.resize(next);
@@ -2655,16 +2722,31 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
   {
     // The points of the triangles with a touched point: the touched points
     // and their rings.
+    // The triangles found in parallel (a serial pass over the corners costs
+    // several milliseconds at a million points), their points marked after.
     m_RelaxSet.assign(m_State.size(), 0);
-    const std::size_t numberOfCorners = m_V.size();
-    for (std::size_t c = 0; c < numberOfCorners; c += 3)
+    const std::size_t                   numberOfTriangles = m_V.size() / 3;
+    constexpr std::size_t               blockSize = 65536;
+    std::vector<std::vector<IndexType>> parts((numberOfTriangles + blockSize - 1) / blockSize);
+    this->ParallelFor(
+      numberOfTriangles,
+      [&](std::size_t first, std::size_t last) {
+        std::vector<IndexType> & part = parts[first / blockSize];
+        for (std::size_t c = 3 * first; c < 3 * last; c += 3)
+        {
+          const IndexType a = m_V[c];
+          if (a != Invalid && ((m_Touched[a] | m_Touched[m_V[c + 1]] | m_Touched[m_V[c + 2]]) & TouchedSinceFlips) != 0)
+          {
+            part.insert(part.end(), { a, m_V[c + 1], m_V[c + 2] });
+          }
+        }
+      },
+      blockSize);
+    for (const auto & part : parts)
     {
-      const IndexType a = m_V[c];
-      if (a != Invalid && ((m_Touched[a] | m_Touched[m_V[c + 1]] | m_Touched[m_V[c + 2]]) & TouchedSinceFlips) != 0)
+      for (const IndexType v : part)
       {
-        m_RelaxSet[a] = 1;
-        m_RelaxSet[m_V[c + 1]] = 1;
-        m_RelaxSet[m_V[c + 2]] = 1;
+        m_RelaxSet[v] = 1;
       }
     }
   }
