@@ -2437,6 +2437,7 @@ DeformableMeshRemesher::ReorderTable(const std::vector<IndexType> & newIndex,
     m_Threader->SetNumberOfWorkUnits(2);
     m_Threader->ParallelizeArray(
       0, 2, [&](SizeValueType part) { body(part); }, nullptr);
+    m_Threader->SetNumberOfWorkUnits(std::max(1u, m_WorkUnits)); // as ParallelFor() leaves it
   };
   halves(count);
   // Per key: the first half's triangles from start[k], the second half's

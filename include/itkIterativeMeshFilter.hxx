@@ -349,7 +349,9 @@ IterativeMeshFilter<TInputMesh, TOutputMesh>::InstallChangedStructure()
     };
     if (numberOfBlocks > 1)
     {
-      this->GetMultiThreader()->ParallelizeArray(0, numberOfBlocks, setBlock, nullptr);
+      MultiThreaderBase * threader = this->GetMultiThreader();
+      threader->SetNumberOfWorkUnits(this->GetNumberOfWorkUnits());
+      threader->ParallelizeArray(0, numberOfBlocks, setBlock, nullptr);
     }
     else if (numberOfBlocks == 1)
     {

@@ -1387,6 +1387,43 @@ TEST(DeformableMeshRemeshing, RejectsABadEdgeLengthIntervalOrCells)
   EXPECT_EQ(edm::test::UpdateAndGetError(filter.GetPointer()), "");
 }
 
+TEST(DeformableMeshRemeshing, CellsTakenOverAcrossARemeshingComeOutAsTriangles)
+{
+  // After a remeshing the filter takes over the output's triangle cells
+  // (their point identifiers set in parallel). A cell that someone replaced
+  // in the output's container by another kind of cell, or by no cell, is
+  // replaced by a triangle: the output is the one of a run left alone.
+  const ElongatedCase & c = Elongated();
+  auto                  reference = c.MakeFilter(1.0, 12);
+  reference->Update();
+  ASSERT_EQ(reference->GetNumberOfRemeshings(), 1u);
+
+  auto filter = c.MakeFilter(1.0, 5);
+  filter->SetIterateFromZero(false);
+  filter->Update();
+  auto & cells = filter->GetOutput()->GetCells()->CastToSTLContainer();
+  ASSERT_GT(cells.size(), 100u);
+  delete cells[3];
+  auto * line = new itk::LineCell<MeshType::CellType>;
+  line->SetPointId(0, 0);
+  line->SetPointId(1, 1);
+  cells[3] = line;
+  delete cells[70];
+  cells[70] = nullptr;
+  filter->SetNumberOfIterations(12);
+  filter->Update();
+  ASSERT_EQ(filter->GetNumberOfRemeshings(), 1u);
+  const MeshType * output = filter->GetOutput();
+  std::size_t      triangles = 0;
+  for (auto it = output->GetCells()->Begin(); it != output->GetCells()->End(); ++it)
+  {
+    ASSERT_NE(it.Value(), nullptr);
+    triangles += it.Value()->GetType() == itk::CommonEnums::CellGeometry::TRIANGLE_CELL ? 1 : 0;
+  }
+  EXPECT_EQ(triangles, output->GetNumberOfCells());
+  EXPECT_TRUE(SameMesh(reference->GetOutput(), output));
+}
+
 TEST(DeformableMeshRenumbering, ARegularSphereSourceIsRenumberedAndGivesTheSameSurface)
 {
   // itk::RegularSphereMeshSource numbers the points of each subdivision far
