@@ -1006,6 +1006,10 @@ private:
   SizeValueType            m_NumberOfPointsLockedByRemeshing{ 0 };
   // The surface's triangles in the internal numbering (remeshing only).
   std::vector<IndexType32> m_Triangles;
+  // With PreventSelfIntersections, the input of the last remeshing (kept
+  // between remeshings: their memory takes the next output).
+  std::vector<double>      m_RemeshInputCoordinates;
+  std::vector<IndexType32> m_RemeshInputTriangles;
   DeformableMeshRemesher   m_Remesher;
   bool                     m_PreventSelfIntersections{ false };
   bool                     m_DampOscillations{ false };

@@ -942,6 +942,8 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
   m_RemeshingStatistics = RemeshingStatisticsType{};
   m_NumberOfPointsLockedByRemeshing = 0;
   m_Remesher.ForgetTable();
+  std::vector<double>().swap(m_RemeshInputCoordinates);
+  std::vector<IndexType32>().swap(m_RemeshInputTriangles);
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
   // The kernels load 4 doubles from a point's 3 coordinates: both arrays
   // of coordinates, swapped at each step, end with a guard value.
@@ -1627,9 +1629,16 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
   m_NumberOfPointsLockedByRemeshing = 0;
   if (m_PreventSelfIntersections)
   {
-    const std::vector<double>      before(x);
-    const std::vector<IndexType32> beforeTriangles(m_Triangles);
-    m_Remesher.Remesh(x, numberOfPoints, m_Triangles);
+    // The input is kept for RemeshWithoutContacts(), which may remesh it
+    // again: it moves (a swap) to m_RemeshInput*, and the remesher writes
+    // its output into the filter's arrays, whose memory the last remeshing
+    // left there (two copies and 48 MB of new pages at a million points,
+    // before).
+    m_RemeshInputCoordinates.swap(x);
+    m_RemeshInputTriangles.swap(m_Triangles);
+    const std::vector<double> &      before = m_RemeshInputCoordinates;
+    const std::vector<IndexType32> & beforeTriangles = m_RemeshInputTriangles;
+    m_Remesher.Remesh(before, numberOfPoints, beforeTriangles, x, m_Triangles);
     const SizeValueType operations = m_OperationsSinceRenumbering;
     const SizeValueType renumberings = m_NumberOfLocalityRenumberings;
     this->RenumberRemeshed(x);
@@ -1979,8 +1988,6 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
         }
       }
     }
-    x.assign(before.begin(), before.end());
-    m_Triangles = beforeTriangles;
     if (!grew)
     {
       // Every triangle in contact was the input's (cannot happen: a changed
@@ -1988,7 +1995,7 @@ DeformableMeshFilter<TMesh, TForceImage>::RemeshWithoutContacts(const std::vecto
       std::fill(locked.begin(), locked.end(), uint8_t{ 1 });
     }
     m_Remesher.SetLockedVertices(locked);
-    m_Remesher.Remesh(x, numberOfPoints, m_Triangles);
+    m_Remesher.Remesh(before, numberOfPoints, beforeTriangles, x, m_Triangles);
     m_NumberOfPointsLockedByRemeshing =
       static_cast<SizeValueType>(std::count(locked.begin(), locked.end(), uint8_t{ 1 }));
     if (!grew)

@@ -228,6 +228,18 @@ public:
   Statistics
   Remesh(std::vector<double> & coordinates, std::size_t numberOfPoints, std::vector<IndexType> & triangles);
 
+  /** Remeshes \a inputCoordinates and \a inputTriangles (as the other
+   * Remesh() takes them) into \a coordinates and \a triangles, whose
+   * contents are replaced (their memory is reused); the inputs are left as
+   * they are, so a caller that may remesh them again need not copy them.
+   * The inputs and outputs may be the same vectors. */
+  Statistics
+  Remesh(const std::vector<double> &    inputCoordinates,
+         std::size_t                    numberOfPoints,
+         const std::vector<IndexType> & inputTriangles,
+         std::vector<double> &          coordinates,
+         std::vector<IndexType> &       triangles);
+
   /** The edges of the last Remesh()'s output, as (min << 32 | max) of their
    * end-points, in no particular order; returns true when each edge is
    * listed once (false when frozen non-manifold edges may repeat). */
@@ -617,8 +629,11 @@ private:
    * fan of \a v. */
   void
   RequeueFan(SweepWorker & worker, IndexType v);
+  /** Writes the output: the points to \a coordinates, the triangles to
+   * \a triangles (left alone when they already hold the input's and the
+   * remeshing changed no corner: \a trianglesHoldInput). */
   void
-  Compact(std::vector<double> & coordinates, std::vector<IndexType> & triangles);
+  Compact(std::vector<double> & coordinates, std::vector<IndexType> & triangles, bool trianglesHoldInput);
   /** The table in a new numbering of its points (\a newIndex, Invalid for
    * removed points, \a newPoints in all): the triangles left, ordered by
    * their smallest new point (a stable counting sort), written to \a
@@ -1280,8 +1295,8 @@ DeformableMeshRemesher::SplitPass(bool all)
   {
     // In parallel: the candidates are sorted below, so their order here
     // does not matter. In the same scan, the short edges for the next
-    // CollapsePass() (blocks of whole 64-bit words).
-    constexpr std::size_t                                  blockSize = 65536;
+    // CollapsePass() (blocks of whole triangles and whole 64-bit words).
+    constexpr std::size_t                                  blockSize = 192 * 341;
     const std::size_t                                      numberOfCorners = m_V.size();
     std::vector<std::vector<std::pair<double, IndexType>>> parts((numberOfCorners + blockSize - 1) / blockSize);
     m_ShortEdges.assign((numberOfCorners + 63) / 64, 0);
@@ -1291,30 +1306,49 @@ DeformableMeshRemesher::SplitPass(bool all)
         std::vector<std::pair<double, IndexType>> & part = parts[first / blockSize];
         uint64_t                                    bits = 0;
         // consider() (SplittableLength2(), ListingCorner()) and
-        // ShortEdge() in one, without branches on which corner lists an
-        // edge (half of them, in no order a predictor follows): each
-        // corner's length, the end-points' states only for the long edges,
-        // Next() counted along.
-        std::size_t k = first % 3;
-        for (std::size_t c = first; c < last; ++c, k = k == 2 ? 0 : k + 1)
+        // ShortEdge() in one, a triangle at a time: its three points read
+        // once for its three edges (the lengths as Length2() computes
+        // them), without branches on which corner lists an edge (half of
+        // them, in no order a predictor follows); the end-points' states
+        // only for the long edges.
+        for (std::size_t t = first; t < last; t += 3)
         {
-          const IndexType a = m_V[c];
-          const Link      o = m_O[c];
-          const bool      valid = a != Invalid;
-          const IndexType b = m_V[k == 2 ? c - 2 : c + 1];
-          const double    length2 = this->Length2(valid ? a : 0, valid ? b : 0);
-          const bool      above = o > static_cast<int64_t>(c);
-          const bool      listed = valid & ((o < 0) | above);
-          if (length2 > m_Max2 && listed && o != NonManifold && m_State[a] != RemesherFrozen &&
-              m_State[b] != RemesherFrozen)
+          const IndexType v[3] = { m_V[t], m_V[t + 1], m_V[t + 2] };
+          double          length2[3] = { 0.0, 0.0, 0.0 };
+          if (v[0] != Invalid && v[1] != Invalid && v[2] != Invalid)
           {
-            part.emplace_back(length2, static_cast<IndexType>(c));
+            const double * p[3] = { m_X.data() + 3 * static_cast<std::size_t>(v[0]),
+                                    m_X.data() + 3 * static_cast<std::size_t>(v[1]),
+                                    m_X.data() + 3 * static_cast<std::size_t>(v[2]) };
+            for (unsigned int k = 0; k < 3; ++k)
+            {
+              const double * a = p[k];
+              const double * b = p[k == 2 ? 0 : k + 1];
+              const double   d0 = a[0] - b[0];
+              const double   d1 = a[1] - b[1];
+              const double   d2 = a[2] - b[2];
+              length2[k] = d0 * d0 + d1 * d1 + d2 * d2;
+            }
           }
-          bits |= static_cast<uint64_t>(valid & above & (length2 < m_Min2)) << (c & 63);
-          if ((c & 63) == 63 || c + 1 == last)
+          for (unsigned int k = 0; k < 3; ++k)
           {
-            m_ShortEdges[c >> 6] = bits;
-            bits = 0;
+            const std::size_t c = t + k;
+            const IndexType   a = v[k];
+            const Link        o = m_O[c];
+            const bool        valid = a != Invalid;
+            const bool        above = o > static_cast<int64_t>(c);
+            const bool        listed = valid & ((o < 0) | above);
+            if (length2[k] > m_Max2 && listed && o != NonManifold && m_State[a] != RemesherFrozen &&
+                m_State[v[k == 2 ? 0 : k + 1]] != RemesherFrozen)
+            {
+              part.emplace_back(length2[k], static_cast<IndexType>(c));
+            }
+            bits |= static_cast<uint64_t>(valid & above & (length2[k] < m_Min2)) << (c & 63);
+            if ((c & 63) == 63 || c + 1 == last)
+            {
+              m_ShortEdges[c >> 6] = bits;
+              bits = 0;
+            }
           }
         }
       },
@@ -2255,7 +2289,9 @@ DeformableMeshRemesher::QueueSecondRound()
 }
 
 inline void
-DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<IndexType> & triangles)
+DeformableMeshRemesher::Compact(std::vector<double> &    coordinates,
+                                std::vector<IndexType> & triangles,
+                                bool                     trianglesHoldInput)
 {
   const std::size_t numberOfPoints = m_State.size();
   const bool        removed =
@@ -2265,7 +2301,7 @@ DeformableMeshRemesher::Compact(std::vector<double> & coordinates, std::vector<I
     // No point added or removed: the numbering and the triangles' order stay
     // (flips changed some corners).
     coordinates.assign(m_X.begin(), m_X.end());
-    if (m_Statistics.flips > 0)
+    if (m_Statistics.flips > 0 || !trianglesHoldInput)
     {
       triangles.assign(m_V.begin(), m_V.end());
     }
@@ -2600,6 +2636,19 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
                                std::size_t              numberOfPoints,
                                std::vector<IndexType> & triangles)
 {
+  return this->Remesh(coordinates, numberOfPoints, triangles, coordinates, triangles);
+}
+
+inline DeformableMeshRemesher::Statistics
+DeformableMeshRemesher::Remesh(const std::vector<double> &    inputCoordinates,
+                               std::size_t                    numberOfPoints,
+                               const std::vector<IndexType> & inputTriangles,
+                               std::vector<double> &          coordinates,
+                               std::vector<IndexType> &       outputTriangles)
+{
+  // The inputs are read only before Compact() writes the outputs: they may
+  // be the same vectors.
+  const std::vector<IndexType> & triangles = inputTriangles;
   if (!(m_TargetEdgeLength > 0.0 && std::isfinite(m_TargetEdgeLength)))
   {
     itkGenericExceptionMacro("DeformableMeshRemesher: the target edge length "
@@ -2613,13 +2662,13 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
                              "are "
                              << m_MinimumRatio << " and " << m_MaximumRatio << ".");
   }
-  if (triangles.size() % 3 != 0 || coordinates.size() < 3 * numberOfPoints ||
+  if (triangles.size() % 3 != 0 || inputCoordinates.size() < 3 * numberOfPoints ||
       numberOfPoints >= std::numeric_limits<IndexType>::max() / 2 ||
       triangles.size() >= static_cast<std::size_t>(std::numeric_limits<Link>::max() / 2))
   {
     itkGenericExceptionMacro("DeformableMeshRemesher: " << triangles.size() << " triangle indices and "
-                                                        << coordinates.size() << " coordinates for " << numberOfPoints
-                                                        << " points.");
+                                                        << inputCoordinates.size() << " coordinates for "
+                                                        << numberOfPoints << " points.");
   }
   // In parallel (a serial pass over the corners costs about as much as a
   // remeshing's operations on a large mesh at rest); the first bad point for
@@ -2657,7 +2706,7 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
   m_PartOfParts = 0;
   m_Min2 = GetMinimumEdgeLength() * GetMinimumEdgeLength();
   m_Max2 = GetMaximumEdgeLength() * GetMaximumEdgeLength();
-  m_X.assign(coordinates.begin(), coordinates.begin() + 3 * numberOfPoints);
+  m_X.assign(inputCoordinates.begin(), inputCoordinates.begin() + 3 * numberOfPoints);
   m_Parents.resize(numberOfPoints);
   std::iota(m_Parents.begin(), m_Parents.end(), IndexType{ 0 });
   // The table of the last output describes this input when it is given
@@ -2780,7 +2829,7 @@ DeformableMeshRemesher::Remesh(std::vector<double> &    coordinates,
   }
   this->CollapsePass();
   this->LengthenPass();
-  this->Compact(coordinates, triangles);
+  this->Compact(coordinates, outputTriangles, &outputTriangles == &inputTriangles);
   if (lock)
   {
     m_TableValid = false; // its frozen states are not the mesh's

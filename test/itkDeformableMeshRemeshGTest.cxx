@@ -397,12 +397,30 @@ TEST(DeformableMeshRemesher, KeptTableGivesTheSameMeshAsAFreshOne)
   // Remesh() keeps the corner table of its output and reuses it when given
   // that output again: each round (the points moved in between) must give,
   // bit for bit, what a remesher that builds its table from the input gives.
+  // So must a remesher that writes its output into other vectors than its
+  // input's (their former contents, of other sizes, replaced), and leaves
+  // the input as it was.
   PointType centre;
   centre.Fill(0.0);
   const auto                  sphere = itk::MakeSphereMesh<MeshType>(centre, 10.0, 3);
   FlatMesh                    kept = ToFlat(sphere);
+  FlatMesh                    apart = kept;
   itk::DeformableMeshRemesher keeping;
+  itk::DeformableMeshRemesher apartRemesher;
   keeping.SetTargetEdgeLength(1.5);
+  apartRemesher.SetTargetEdgeLength(1.5);
+  const auto remeshApart = [&apart, &apartRemesher](const FlatMesh & expected, int round) {
+    const FlatMesh         input = apart;
+    std::vector<double>    x(7, -1.0);
+    std::vector<IndexType> triangles(5, 3);
+    apartRemesher.Remesh(apart.x, apart.Points(), apart.triangles, x, triangles);
+    ASSERT_EQ(apart.x, input.x) << "round " << round;
+    ASSERT_EQ(apart.triangles, input.triangles) << "round " << round;
+    ASSERT_EQ(triangles, expected.triangles) << "round " << round;
+    ASSERT_EQ(x, expected.x) << "round " << round;
+    apart.x.swap(x);
+    apart.triangles.swap(triangles);
+  };
   bool unchanged = false;
   for (int round = 0; round < 12; ++round)
   {
@@ -414,6 +432,8 @@ TEST(DeformableMeshRemesher, KeptTableGivesTheSameMeshAsAFreshOne)
     ASSERT_EQ(kept.triangles, fresh.triangles) << "round " << round;
     ASSERT_EQ(kept.x, fresh.x) << "round " << round;
     ASSERT_EQ(keeping.Parents(), building.Parents()) << "round " << round;
+    remeshApart(kept, round);
+    ASSERT_EQ(apartRemesher.Parents(), keeping.Parents()) << "round " << round;
     std::vector<uint64_t> edgesKept;
     std::vector<uint64_t> edgesFresh;
     EXPECT_EQ(keeping.Edges(edgesKept), building.Edges(edgesFresh));
@@ -437,6 +457,7 @@ TEST(DeformableMeshRemesher, KeptTableGivesTheSameMeshAsAFreshOne)
     for (std::size_t i = 0; i < kept.Points(); ++i)
     {
       kept.x[3 * i + 2] *= 1.04;
+      apart.x[3 * i + 2] *= 1.04;
     }
   }
   EXPECT_FALSE(unchanged) << "the stretch makes every round change the mesh";
@@ -444,10 +465,16 @@ TEST(DeformableMeshRemesher, KeptTableGivesTheSameMeshAsAFreshOne)
   // toward valence 6 are done changes no connectivity: the numbering and
   // the triangles stay, only the relaxation moves points.
   keeping.SetEdgeLengthRatios(0.01, 100.0);
-  keeping.Remesh(kept.x, kept.Points(), kept.triangles);
-  keeping.Remesh(kept.x, kept.Points(), kept.triangles);
+  apartRemesher.SetEdgeLengthRatios(0.01, 100.0);
+  for (int round = 12; round < 14; ++round)
+  {
+    keeping.Remesh(kept.x, kept.Points(), kept.triangles);
+    remeshApart(kept, round);
+  }
   const FlatMesh before = kept;
   const auto     statistics = keeping.Remesh(kept.x, kept.Points(), kept.triangles);
+  // Connectivity unchanged: the separate output gets the triangles too.
+  remeshApart(kept, 14);
   EXPECT_EQ(statistics.splits + statistics.collapses + statistics.flips, 0u);
   EXPECT_FALSE(keeping.GetTopologyChanged());
   EXPECT_EQ(kept.triangles, before.triangles);
