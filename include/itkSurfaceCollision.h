@@ -1577,6 +1577,14 @@ public:
   {
     return m_TotalNumberOfCarriedCertificates;
   }
+  /** How many times, in all, a triangle with a point beyond the carried
+   * margin was found to keep its orientation by its own margin, without the
+   * exact signs (CarriedTo()). */
+  SizeValueType
+  GetTotalNumberOfTrianglesWithinOwnMargin() const
+  {
+    return m_TotalNumberOfTrianglesWithinOwnMargin;
+  }
   /** The margin carried from the last certificate without folds (0 when
    * none): positions with every point within it of the certified ones are
    * certified without the certificate's passes (CarryCertificate()). */
@@ -3138,6 +3146,56 @@ private:
     m_CarriedMargin = margin;
     std::copy(o, o + 3, m_CarriedCentre);
     m_CarriedSign = sign > 0.0 ? 1 : -1;
+    m_CarriedRounding = rounding;
+  }
+
+  /** Whether the triangle \a vt keeps its orientation seen from the carried
+   * centre all along the straight path from the certified positions x0 to
+   * \a y, by its own margin: CarryCertificate()'s bound f for this triangle
+   * alone (the margin is the least f of all), computed again from x0 the
+   * same way, and every point of the triangle within it of x0. */
+  bool
+  WithinOwnMargin(const double * x0, const double * y, const IndexType * vt) const
+  {
+    using SurfaceCollisionDetail::Dot;
+    const double * o = m_CarriedCentre;
+    double         a[3];
+    double         b[3];
+    double         c[3];
+    SurfaceCollisionDetail::Subtract(x0 + 3 * static_cast<SizeValueType>(vt[0]), o, a);
+    SurfaceCollisionDetail::Subtract(x0 + 3 * static_cast<SizeValueType>(vt[1]), o, b);
+    SurfaceCollisionDetail::Subtract(x0 + 3 * static_cast<SizeValueType>(vt[2]), o, c);
+    double bc[3];
+    double ca[3];
+    double ab[3];
+    SurfaceCollisionDetail::Cross(b, c, bc);
+    SurfaceCollisionDetail::Cross(c, a, ca);
+    SurfaceCollisionDetail::Cross(a, b, ab);
+    const double d = static_cast<double>(m_CarriedSign) * Dot(a, bc) - m_CarriedRounding;
+    if (!(d > 0.0))
+    {
+      return false; // NaN too
+    }
+    const double s1 = std::sqrt(3.0 * (Dot(bc, bc) + Dot(ca, ca) + Dot(ab, ab)));
+    const double s2 = std::sqrt(3.0 * (Dot(a, a) + Dot(b, b) + Dot(c, c)));
+    const double cap = d / s1;
+    // As the carried margin and its limit in CarriedTo(): a millionth less
+    // for the rounding of S1, S2 and the quotients, another for the squares.
+    const double f = (1.0 - 1e-6) * (d / (s1 + cap * s2 + cap * cap));
+    const double limit = (1.0 - 1e-6) * f * f;
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      const double * p = x0 + 3 * static_cast<SizeValueType>(vt[k]);
+      const double * q = y + 3 * static_cast<SizeValueType>(vt[k]);
+      const double   dx = q[0] - p[0];
+      const double   dy = q[1] - p[1];
+      const double   dz = q[2] - p[2];
+      if (!(dx * dx + dy * dy + dz * dz <= limit)) // NaN: not within
+      {
+        return false;
+      }
+    }
+    return true;
   }
 
   /** Whether \a y is star-shaped from the centre of the carried certificate
@@ -3145,7 +3203,10 @@ private:
    * over the points finds those farther than the carried margin from their
    * certified positions x0. None: y is within the margin (CarryCertificate()).
    * At most a 32nd of the points: every triangle with such a point must keep
-   * its orientation along the straight path from x0 to y. Along it each
+   * its orientation along the straight path from x0 to y. It does when its
+   * points stay within its own margin (WithinOwnMargin(): the carried
+   * margin is the least of these, and most triangles' are several times
+   * larger); else, along the path, each
    * point is (1 - t) p0 + t p1, and the orientation determinant, linear in
    * each of the triangle's three points, is the sum, over the 8 ways of
    * taking each point at x0 or at y, of (1 - t)^i t^j (i points taken at
@@ -3194,15 +3255,21 @@ private:
     {
       return false;
     }
-    const SizeValueType  numberOfTriangles = this->GetNumberOfTriangles();
-    const uint8_t *      flags = m_CarriedFar.data();
-    std::vector<uint8_t> turned((numberOfTriangles + block - 1) / block, 0);
+    const SizeValueType        numberOfTriangles = this->GetNumberOfTriangles();
+    const uint8_t *            flags = m_CarriedFar.data();
+    std::vector<uint8_t>       turned((numberOfTriangles + block - 1) / block, 0);
+    std::vector<SizeValueType> ownMargins(turned.size(), 0);
     parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
       for (SizeValueType t = begin; t < end; ++t)
       {
         const IndexType * vt = m_Triangles.data() + 3 * t;
         if ((flags[vt[0]] | flags[vt[1]] | flags[vt[2]]) == 0)
         {
+          continue;
+        }
+        if (this->WithinOwnMargin(x0, y, vt))
+        {
+          ++ownMargins[begin / block];
           continue;
         }
         const double * ends[3][2];
@@ -3223,6 +3290,8 @@ private:
         }
       }
     });
+    m_TotalNumberOfTrianglesWithinOwnMargin +=
+      std::accumulate(ownMargins.begin(), ownMargins.end(), SizeValueType{ 0 });
     return std::find(turned.begin(), turned.end(), uint8_t{ 1 }) == turned.end();
   }
 
@@ -4749,7 +4818,9 @@ private:
   double               m_CarriedMargin{ 0.0 };
   double               m_CarriedCentre[3]{ 0.0, 0.0, 0.0 }; // the certificate's centre
   int                  m_CarriedSign{ 0 };                  // the orientation of its triangles seen from it
-  std::vector<uint8_t> m_CarriedFar;                        // CarriedTo(): per point, beyond the margin
+  double               m_CarriedRounding{ 0.0 };            // StarShaped()'s bound of the determinants' rounding
+  SizeValueType        m_TotalNumberOfTrianglesWithinOwnMargin{ 0 };
+  std::vector<uint8_t> m_CarriedFar; // CarriedTo(): per point, beyond the margin
   SizeValueType        m_TotalNumberOfCarriedCertificates{ 0 };
   // CarryNow(): the steps certified by the last carried margin, whether one
   // was computed since the last decision, and the wait before the next.

@@ -1256,6 +1256,70 @@ TEST(SurfaceCollision, TheCertificateFollowsTheTrianglesOfPointsBeyondItsMargin)
   EXPECT_GT(carriedPast, 20u);
   EXPECT_GT(decidedOtherwise, 20u);
   EXPECT_EQ(throughCaught, 30u);
+
+  // Nearer moves: up to 8 points moved by 1 to 8 carried margins, in random
+  // directions, from a sphere whose points were first jittered by 5 % of an
+  // edge (so that the triangles' own margins differ). A step carried must be
+  // star-shaped by a fresh certificate and free of intersecting pairs; some
+  // triangles are kept by their own margins (WithinOwnMargin()), and some
+  // steps still need the exact signs or a certificate.
+  std::vector<double> jittered = x;
+  {
+    std::normal_distribution<double> normal(0.0, 1.0);
+    for (double & v : jittered)
+    {
+      v += 0.05 * 1.1 * normal(random) / std::sqrt(3.0);
+    }
+  }
+  std::size_t byOwnMargins = 0;
+  std::size_t nearCarried = 0;
+  std::size_t nearOtherwise = 0;
+  for (int trial = 0; trial < 120; ++trial)
+  {
+    itk::SurfaceCollision collision;
+    collision.SetSurface(n, triangles.data(), numberOfTriangles);
+    std::vector<double> y = jittered;
+    ASSERT_EQ(collision.Constrain(jittered.data(), y.data(), 0.0, nullptr, 1).constrained, 0u);
+    const double margin = collision.GetCarriedMargin();
+    ASSERT_GT(margin, 0.0);
+    std::uniform_int_distribution<std::size_t> pick(0, n - 1);
+    std::normal_distribution<double>           normal(0.0, 1.0);
+    const std::size_t                          moved = 1 + static_cast<std::size_t>(trial) % 8;
+    for (std::size_t m = 0; m < moved; ++m)
+    {
+      const std::size_t i = pick(random);
+      double            v[3] = { normal(random), normal(random), normal(random) };
+      const double      length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      const double      distance = margin * (1.0 + 7.0 * static_cast<double>(trial % 15) / 14.0);
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        y[3 * i + d] = jittered[3 * i + d] + distance * v[d] / length;
+      }
+    }
+    const std::vector<double> proposed = y;
+    const std::size_t         carried = collision.GetTotalNumberOfCarriedCertificates();
+    const std::size_t         within = collision.GetTotalNumberOfTrianglesWithinOwnMargin();
+    const auto                result = collision.Constrain(jittered.data(), y.data(), 0.0, nullptr, 1);
+    const bool                carriedNow = collision.GetTotalNumberOfCarriedCertificates() > carried;
+    byOwnMargins += collision.GetTotalNumberOfTrianglesWithinOwnMargin() - within;
+    nearCarried += carriedNow ? 1 : 0;
+    nearOtherwise += carriedNow ? 0 : 1;
+    EXPECT_EQ(CheckAllPairs(y, triangles, 0.0).intersecting, 0u) << "trial " << trial;
+    if (result.constrained == 0)
+    {
+      EXPECT_EQ(y, proposed);
+    }
+    if (carriedNow)
+    {
+      itk::SurfaceCollision fresh;
+      fresh.SetSurface(n, triangles.data(), numberOfTriangles);
+      EXPECT_TRUE(fresh.IsStarShaped(y.data())) << "trial " << trial;
+    }
+  }
+  std::cout << nearCarried << " near steps carried, " << nearOtherwise << " decided otherwise, " << byOwnMargins
+            << " triangles kept by their own margins" << std::endl;
+  EXPECT_GT(byOwnMargins, 100u);
+  EXPECT_GT(nearCarried, 60u);
 }
 
 TEST(SurfaceCollision, TheCertificateTakesFoldsThatMeetNothing)
