@@ -1271,7 +1271,8 @@ struct ParallelBlocks
  * star-shaped from the same centre: a pass over the points instead of the
  * certificate's passes. When a few points (at most a 32nd) have left it,
  * the triangles around them are followed along the straight path from the
- * certified positions, by 7 exact orientation signs each (CarriedTo()):
+ * certified positions, by their own margins (the same bound for each
+ * triangle alone) or else by 7 exact orientation signs each (CarriedTo()):
  * the certificate is computed again, with new margins, only when more
  * points have left, when one of those triangles may turn on the way, or
  * when the surface changes (SetSurface()). The margins are about a fifth
