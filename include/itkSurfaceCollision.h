@@ -3054,6 +3054,38 @@ private:
     double        sharedBound{ 0.0 }; // StarOrientation()'s bound
   };
 
+  /** For the triangle \a vt at positions \a x, seen from \a o: d = s D - r
+   * (D its orientation determinant, s its certified \a sign, r the
+   * determinants' \a rounding bound), and the squares of the upper bounds
+   * of S1 and S2 that CarryCertificate() describes. */
+  static void
+  MarginTerms(const double *    x,
+              const IndexType * vt,
+              const double *    o,
+              double            sign,
+              double            rounding,
+              double &          d,
+              double &          s1Squared,
+              double &          s2Squared)
+  {
+    using SurfaceCollisionDetail::Dot;
+    double a[3];
+    double b[3];
+    double c[3];
+    SurfaceCollisionDetail::Subtract(x + 3 * static_cast<SizeValueType>(vt[0]), o, a);
+    SurfaceCollisionDetail::Subtract(x + 3 * static_cast<SizeValueType>(vt[1]), o, b);
+    SurfaceCollisionDetail::Subtract(x + 3 * static_cast<SizeValueType>(vt[2]), o, c);
+    double bc[3];
+    double ca[3];
+    double ab[3];
+    SurfaceCollisionDetail::Cross(b, c, bc);
+    SurfaceCollisionDetail::Cross(c, a, ca);
+    SurfaceCollisionDetail::Cross(a, b, ab);
+    d = sign * Dot(a, bc) - rounding;
+    s1Squared = 3.0 * (Dot(bc, bc) + Dot(ca, ca) + Dot(ab, ab));
+    s2Squared = 3.0 * (Dot(a, a) + Dot(b, b) + Dot(c, c));
+  }
+
   /** The star-shaped certificate carried to nearby positions. With centre
    * o fixed, write A = a - o, B = b - o, C = c - o for a triangle's points
    * at the certified positions x0, whose orientation determinant
@@ -3081,7 +3113,6 @@ private:
   void
   CarryCertificate(const double * x, const StarSummary & summary, TParallel && parallel)
   {
-    using SurfaceCollisionDetail::Dot;
     const SizeValueType numberOfTriangles = this->GetNumberOfTriangles();
     m_CarriedMargin = 0.0;
     if (numberOfTriangles == 0)
@@ -3102,22 +3133,10 @@ private:
       double m = std::numeric_limits<double>::infinity();
       for (SizeValueType t = begin; t < end; ++t)
       {
-        const IndexType * vt = m_Triangles.data() + 3 * t;
-        double            a[3];
-        double            b[3];
-        double            c[3];
-        SurfaceCollisionDetail::Subtract(x + 3 * static_cast<SizeValueType>(vt[0]), o, a);
-        SurfaceCollisionDetail::Subtract(x + 3 * static_cast<SizeValueType>(vt[1]), o, b);
-        SurfaceCollisionDetail::Subtract(x + 3 * static_cast<SizeValueType>(vt[2]), o, c);
-        double bc[3];
-        double ca[3];
-        double ab[3];
-        SurfaceCollisionDetail::Cross(b, c, bc);
-        SurfaceCollisionDetail::Cross(c, a, ca);
-        SurfaceCollisionDetail::Cross(a, b, ab);
-        const double d = sign * Dot(a, bc) - rounding;
-        const double s1Squared = 3.0 * (Dot(bc, bc) + Dot(ca, ca) + Dot(ab, ab));
-        const double s2Squared = 3.0 * (Dot(a, a) + Dot(b, b) + Dot(c, c));
+        double d;
+        double s1Squared;
+        double s2Squared;
+        MarginTerms(x, m_Triangles.data() + 3 * t, o, sign, rounding, d, s1Squared, s2Squared);
         const double c2 = d * d / s1Squared;
         if (d > 0.0 && d * d >= m * m * (1.11 * (s1Squared + 10.0 * c2 * s2Squared + 100.0 * c2 * c2)))
         {
@@ -3158,27 +3177,17 @@ private:
   bool
   WithinOwnMargin(const double * x0, const double * y, const IndexType * vt) const
   {
-    using SurfaceCollisionDetail::Dot;
-    const double * o = m_CarriedCentre;
-    double         a[3];
-    double         b[3];
-    double         c[3];
-    SurfaceCollisionDetail::Subtract(x0 + 3 * static_cast<SizeValueType>(vt[0]), o, a);
-    SurfaceCollisionDetail::Subtract(x0 + 3 * static_cast<SizeValueType>(vt[1]), o, b);
-    SurfaceCollisionDetail::Subtract(x0 + 3 * static_cast<SizeValueType>(vt[2]), o, c);
-    double bc[3];
-    double ca[3];
-    double ab[3];
-    SurfaceCollisionDetail::Cross(b, c, bc);
-    SurfaceCollisionDetail::Cross(c, a, ca);
-    SurfaceCollisionDetail::Cross(a, b, ab);
-    const double d = static_cast<double>(m_CarriedSign) * Dot(a, bc) - m_CarriedRounding;
+    double d;
+    double s1Squared;
+    double s2Squared;
+    MarginTerms(
+      x0, vt, m_CarriedCentre, static_cast<double>(m_CarriedSign), m_CarriedRounding, d, s1Squared, s2Squared);
     if (!(d > 0.0))
     {
       return false; // NaN too
     }
-    const double s1 = std::sqrt(3.0 * (Dot(bc, bc) + Dot(ca, ca) + Dot(ab, ab)));
-    const double s2 = std::sqrt(3.0 * (Dot(a, a) + Dot(b, b) + Dot(c, c)));
+    const double s1 = std::sqrt(s1Squared);
+    const double s2 = std::sqrt(s2Squared);
     const double cap = d / s1;
     // As the carried margin and its limit in CarriedTo(): a millionth less
     // for the rounding of S1, S2 and the quotients, another for the squares.

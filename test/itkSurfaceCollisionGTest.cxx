@@ -1189,9 +1189,34 @@ TEST(SurfaceCollision, TheCertificateFollowsTheTrianglesOfPointsBeyondItsMargin)
   const std::size_t n = x.size() / 3;
   const std::size_t numberOfTriangles = triangles.size() / 3;
   std::mt19937      random(11);
-  std::size_t       carriedPast = 0;
-  std::size_t       decidedOtherwise = 0;
-  std::size_t       throughCaught = 0;
+  // A step from the certified positions \a from to \a y: left as proposed
+  // unless constrained, free of intersecting pairs, and star-shaped by a
+  // fresh certificate when carried. Returns whether it was carried, and
+  // whether it was constrained.
+  const auto step = [&](itk::SurfaceCollision &     collision,
+                        const std::vector<double> & from,
+                        std::vector<double> &       y,
+                        int                         trial) -> std::pair<bool, bool> {
+    const std::vector<double> proposed = y;
+    const std::size_t         carried = collision.GetTotalNumberOfCarriedCertificates();
+    const auto                result = collision.Constrain(from.data(), y.data(), 0.0, nullptr, 1);
+    const bool                carriedNow = collision.GetTotalNumberOfCarriedCertificates() > carried;
+    EXPECT_EQ(CheckAllPairs(y, triangles, 0.0).intersecting, 0u) << "trial " << trial;
+    if (result.constrained == 0)
+    {
+      EXPECT_EQ(y, proposed);
+    }
+    if (carriedNow)
+    {
+      itk::SurfaceCollision fresh;
+      fresh.SetSurface(n, triangles.data(), numberOfTriangles);
+      EXPECT_TRUE(fresh.IsStarShaped(y.data())) << "trial " << trial;
+    }
+    return { carriedNow, result.constrained > 0 };
+  };
+  std::size_t carriedPast = 0;
+  std::size_t decidedOtherwise = 0;
+  std::size_t throughCaught = 0;
   for (int trial = 0; trial < 120; ++trial)
   {
     itk::SurfaceCollision collision;
@@ -1228,27 +1253,13 @@ TEST(SurfaceCollision, TheCertificateFollowsTheTrianglesOfPointsBeyondItsMargin)
         y[3 * i + d] = x[3 * i + d] + scale * normal(random);
       }
     }
-    const std::vector<double> proposed = y;
-    const std::size_t         carried = collision.GetTotalNumberOfCarriedCertificates();
-    const auto                result = collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1);
-    const bool                carriedNow = collision.GetTotalNumberOfCarriedCertificates() > carried;
+    const auto [carriedNow, constrained] = step(collision, x, y, trial);
     carriedPast += carriedNow ? 1 : 0;
     decidedOtherwise += carriedNow ? 0 : 1;
-    EXPECT_EQ(CheckAllPairs(y, triangles, 0.0).intersecting, 0u) << "trial " << trial;
-    if (result.constrained == 0)
-    {
-      EXPECT_EQ(y, proposed);
-    }
-    if (carriedNow)
-    {
-      itk::SurfaceCollision fresh;
-      fresh.SetSurface(n, triangles.data(), numberOfTriangles);
-      EXPECT_TRUE(fresh.IsStarShaped(y.data())) << "trial " << trial;
-      EXPECT_FALSE(through) << "trial " << trial << ": a point through the sphere carried";
-    }
+    EXPECT_FALSE(carriedNow && through) << "trial " << trial << ": a point through the sphere carried";
     if (through)
     {
-      throughCaught += result.constrained > 0 ? 1 : 0;
+      throughCaught += constrained ? 1 : 0;
     }
   }
   std::cout << carriedPast << " steps carried past the margin, " << decidedOtherwise << " decided otherwise, "
@@ -1296,25 +1307,11 @@ TEST(SurfaceCollision, TheCertificateFollowsTheTrianglesOfPointsBeyondItsMargin)
         y[3 * i + d] = jittered[3 * i + d] + distance * v[d] / length;
       }
     }
-    const std::vector<double> proposed = y;
-    const std::size_t         carried = collision.GetTotalNumberOfCarriedCertificates();
-    const std::size_t         within = collision.GetTotalNumberOfTrianglesWithinOwnMargin();
-    const auto                result = collision.Constrain(jittered.data(), y.data(), 0.0, nullptr, 1);
-    const bool                carriedNow = collision.GetTotalNumberOfCarriedCertificates() > carried;
+    const std::size_t within = collision.GetTotalNumberOfTrianglesWithinOwnMargin();
+    const bool        carriedNow = step(collision, jittered, y, trial).first;
     byOwnMargins += collision.GetTotalNumberOfTrianglesWithinOwnMargin() - within;
     nearCarried += carriedNow ? 1 : 0;
     nearOtherwise += carriedNow ? 0 : 1;
-    EXPECT_EQ(CheckAllPairs(y, triangles, 0.0).intersecting, 0u) << "trial " << trial;
-    if (result.constrained == 0)
-    {
-      EXPECT_EQ(y, proposed);
-    }
-    if (carriedNow)
-    {
-      itk::SurfaceCollision fresh;
-      fresh.SetSurface(n, triangles.data(), numberOfTriangles);
-      EXPECT_TRUE(fresh.IsStarShaped(y.data())) << "trial " << trial;
-    }
   }
   std::cout << nearCarried << " near steps carried, " << nearOtherwise << " decided otherwise, " << byOwnMargins
             << " triangles kept by their own margins" << std::endl;
