@@ -1042,6 +1042,7 @@ private:
   std::vector<IndexType32> m_NeighbourOffsets;
   std::vector<IndexType32> m_Neighbours;
   std::vector<uint8_t>     m_RingKinds;
+  bool                     m_ClosedFans{ false }; // every ring a closed fan (FindBoundaryVertices())
   std::vector<IndexType32> m_GeneralVertices;
   std::vector<IndexType32> m_GeneralPairOffsets;
   std::vector<IndexType32> m_GeneralPairs;

@@ -783,6 +783,7 @@ DeformableMeshFilter<TMesh, TForceImage>::FindBoundaryVertices(const std::vector
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
   m_BoundaryVertices.clear();
   const auto neighbourCount = [this](SizeValueType i) { return m_NeighbourOffsets[i + 1] - m_NeighbourOffsets[i]; };
+  m_ClosedFans = false;
   if (PointDimension == 2)
   {
     // The ends of open contours.
@@ -804,6 +805,9 @@ DeformableMeshFilter<TMesh, TForceImage>::FindBoundaryVertices(const std::vector
   }
   if (!anyOpen)
   {
+    // Every ring is a closed fan of the triangles (BuildTopology(),
+    // BuildTopologyFromRemesher()).
+    m_ClosedFans = true;
     return;
   }
   // The edges of one triangle only, and the ends of lines (one neighbour,
@@ -1067,8 +1071,16 @@ DeformableMeshFilter<TMesh, TForceImage>::ConstrainSelfIntersections(std::vector
   // coordinates, or with internal sub-steps (ReferenceEdgeLength) the copy
   // taken before them. Reduced displacements are measured from it.
   const std::vector<double> & start = m_NumberOfSubSteps > 1 ? m_IterationStart : this->GetCoordinates();
-  const auto                  result = m_Collision.Constrain(
+  // A closed surface's fans, built from the collision test's own
+  // triangles (the remeshed m_Triangles): a carried certificate visits the
+  // triangles of the points that moved beyond its margin through them.
+  if (m_ClosedFans && m_CollisionTrianglesAreMeshTriangles)
+  {
+    m_Collision.SetPointFans(m_NeighbourOffsets.data(), m_Neighbours.data());
+  }
+  const auto result = m_Collision.Constrain(
     start.data(), m_NextCoordinates.data(), m_MinimumDistance, this->GetMultiThreader(), this->GetNumberOfWorkUnits());
+  m_Collision.SetPointFans(nullptr, nullptr);
   m_NumberOfCollisionsPrevented = result.violations;
   m_TotalNumberOfCollisionsPrevented += result.violations;
   m_NumberOfConstrainedVertices = result.constrained;

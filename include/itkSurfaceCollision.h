@@ -1363,6 +1363,8 @@ public:
   {
     m_NumberOfPoints = numberOfPoints;
     m_Triangles.assign(triangles, triangles + 3 * numberOfTriangles);
+    m_FanOffsets = nullptr;
+    m_FanNeighbours = nullptr;
     // Per point, the triangles that use it: made when first needed (the
     // closed-surface check below, the constraint of a step the certificate
     // does not accept, the index's shared pairs).
@@ -1520,6 +1522,29 @@ public:
     return m_HasSurface;
   }
 
+  /** Each point's fan, as the caller's own tables hold it, for CarriedTo():
+   * the neighbours of point i are \a neighbours[offsets[i]] to
+   * \a neighbours[offsets[i + 1] - 1] in the cyclic order of its triangles,
+   * (i, r_k, r_k+1) with k cyclic being a triangle of SetSurface() in its own
+   * order (turned, not reversed). The certificate carried to new positions
+   * then visits the triangles of the points beyond the carried margin
+   * through these fans instead of a pass over all the triangles. Only for a
+   * closed surface: every triangle is in the fans of its three points, so
+   * offsets[NumberOfPoints] must be three times the number of triangles
+   * (else the fans are ignored). The caller vouches that the fans describe
+   * SetSurface()'s triangles exactly (a wrong claim would let the
+   * certificate accept positions it must not), and keeps the arrays alive
+   * and unchanged until SetPointFans(nullptr, nullptr) or SetSurface(),
+   * which drops them. */
+  void
+  SetPointFans(const IndexType * offsets, const IndexType * neighbours)
+  {
+    const bool usable = offsets != nullptr && neighbours != nullptr && m_HasSurface && m_Closed && !m_RepeatedPoint &&
+                        static_cast<SizeValueType>(offsets[m_NumberOfPoints]) == m_Triangles.size();
+    m_FanOffsets = usable ? offsets : nullptr;
+    m_FanNeighbours = usable ? neighbours : nullptr;
+  }
+
   /** Drops the spatial index (the next Constrain() rebuilds it), for
    * example when the positions were changed outside Constrain(). */
   void
@@ -1585,6 +1610,14 @@ public:
   GetTotalNumberOfTrianglesWithinOwnMargin() const
   {
     return m_TotalNumberOfTrianglesWithinOwnMargin;
+  }
+  /** How many times, in all, a point beyond the carried margin was found
+   * within its own (the least own margin of its triangles), so that its
+   * triangles needed no test: with the fans of SetPointFans() only. */
+  SizeValueType
+  GetTotalNumberOfPointsWithinOwnMargin() const
+  {
+    return m_TotalNumberOfPointsWithinOwnMargin;
   }
   /** The margin carried from the last certificate without folds (0 when
    * none): positions with every point within it of the certified ones are
@@ -3167,6 +3200,7 @@ private:
     std::copy(o, o + 3, m_CarriedCentre);
     m_CarriedSign = sign > 0.0 ? 1 : -1;
     m_CarriedRounding = rounding;
+    m_PointLimitsReady = false;
   }
 
   /** Whether the triangle \a vt keeps its orientation seen from the carried
@@ -3177,6 +3211,30 @@ private:
   bool
   WithinOwnMargin(const double * x0, const double * y, const IndexType * vt) const
   {
+    const double limit = this->OwnMarginLimit(x0, vt);
+    if (!(limit > 0.0))
+    {
+      return false;
+    }
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      if (!(SquaredDistance(x0, y, vt[k]) <= limit)) // NaN: not within
+      {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  /** The square of the triangle \a vt's own margin (WithinOwnMargin()),
+   * less the rounding of the squares, to compare with squared distances;
+   * 0 when the triangle has none (its determinant not certainly of the
+   * certified sign in this order, or NaN). Any turn of the triangle's
+   * points gives a margin of its own (the same bound, rounded in another
+   * order). */
+  double
+  OwnMarginLimit(const double * x0, const IndexType * vt) const
+  {
     double d;
     double s1Squared;
     double s2Squared;
@@ -3184,7 +3242,7 @@ private:
       x0, vt, m_CarriedCentre, static_cast<double>(m_CarriedSign), m_CarriedRounding, d, s1Squared, s2Squared);
     if (!(d > 0.0))
     {
-      return false; // NaN too
+      return 0.0; // NaN too
     }
     const double s1 = std::sqrt(s1Squared);
     const double s2 = std::sqrt(s2Squared);
@@ -3193,19 +3251,19 @@ private:
     // for the rounding of S1, S2 and the quotients, another for the squares.
     const double f = (1.0 - 1e-6) * (d / (s1 + cap * s2 + cap * cap));
     const double limit = (1.0 - 1e-6) * f * f;
-    for (unsigned int k = 0; k < 3; ++k)
-    {
-      const double * p = x0 + 3 * static_cast<SizeValueType>(vt[k]);
-      const double * q = y + 3 * static_cast<SizeValueType>(vt[k]);
-      const double   dx = q[0] - p[0];
-      const double   dy = q[1] - p[1];
-      const double   dz = q[2] - p[2];
-      if (!(dx * dx + dy * dy + dz * dz <= limit)) // NaN: not within
-      {
-        return false;
-      }
-    }
-    return true;
+    return limit > 0.0 ? limit : 0.0;
+  }
+
+  /** The squared distance between point \a v at \a x0 and at \a y. */
+  static double
+  SquaredDistance(const double * x0, const double * y, IndexType v)
+  {
+    const double * p = x0 + 3 * static_cast<SizeValueType>(v);
+    const double * q = y + 3 * static_cast<SizeValueType>(v);
+    const double   dx = q[0] - p[0];
+    const double   dy = q[1] - p[1];
+    const double   dz = q[2] - p[2];
+    return dx * dx + dy * dy + dz * dz;
   }
 
   /** Whether \a y is star-shaped from the centre of the carried certificate
@@ -3265,6 +3323,10 @@ private:
     {
       return false;
     }
+    if (m_FanOffsets != nullptr)
+    {
+      return this->CarriedAlongFans(x0, y, parallel);
+    }
     const SizeValueType        numberOfTriangles = this->GetNumberOfTriangles();
     const uint8_t *            flags = m_CarriedFar.data();
     std::vector<uint8_t>       turned((numberOfTriangles + block - 1) / block, 0);
@@ -3273,26 +3335,163 @@ private:
       for (SizeValueType t = begin; t < end; ++t)
       {
         const IndexType * vt = m_Triangles.data() + 3 * t;
-        if ((flags[vt[0]] | flags[vt[1]] | flags[vt[2]]) == 0)
+        if ((flags[vt[0]] | flags[vt[1]] | flags[vt[2]]) != 0 &&
+            !this->KeepsCarriedOrientation(x0, y, vt, false, ownMargins[begin / block]))
+        {
+          turned[begin / block] = 1;
+          return;
+        }
+      }
+    });
+    m_TotalNumberOfTrianglesWithinOwnMargin +=
+      std::accumulate(ownMargins.begin(), ownMargins.end(), SizeValueType{ 0 });
+    return std::find(turned.begin(), turned.end(), uint8_t{ 1 }) == turned.end();
+  }
+
+  /** CarriedTo()'s test of one triangle \a vt with a point beyond the
+   * carried margin: whether it keeps its orientation along the straight
+   * path from x0 to \a y, by its own margin (counted in \a ownMargins) or
+   * else by the 7 exact signs that involve y. \a checkStart: the order of
+   * \a vt is not known to be the certified one, whose sign at x0 is then
+   * checked too (an 8th exact sign). */
+  bool
+  KeepsCarriedOrientation(const double *    x0,
+                          const double *    y,
+                          const IndexType * vt,
+                          bool              checkStart,
+                          SizeValueType &   ownMargins) const
+  {
+    if (this->WithinOwnMargin(x0, y, vt))
+    {
+      ++ownMargins;
+      return true;
+    }
+    const double * ends[3][2];
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      ends[k][0] = x0 + 3 * static_cast<SizeValueType>(vt[k]);
+      ends[k][1] = y + 3 * static_cast<SizeValueType>(vt[k]);
+    }
+    for (unsigned int choice = checkStart ? 0 : 1; choice < 8; ++choice)
+    {
+      if (SurfaceCollisionDetail::Orient3DSign(
+            m_CarriedCentre, ends[0][choice & 1], ends[1][(choice >> 1) & 1], ends[2][(choice >> 2) & 1]) !=
+          m_CarriedSign)
+      {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  /** CarriedTo() with the caller's fans (SetPointFans()), in proportion
+   * to the points beyond the carried margin (about 1 % of them at rest)
+   * instead of the triangles. Each such point p has a margin of its own,
+   * the least own margin of the triangles of its fan (OwnMarginLimit(), in
+   * the fan's order: a turn of each triangle's own), computed once per
+   * carried certificate when p first goes beyond the carried margin. A
+   * point within it is cleared. A triangle whose points are each within a
+   * margin of that triangle (the carried margin, or its own in the order of
+   * one of its points) has every point within the largest of these, a
+   * margin of the triangle: it keeps its orientation. So only the triangles
+   * with a point not cleared are tested (KeepsCarriedOrientation()), each
+   * once, from the first such point of the triangle. */
+  template <typename TParallel>
+  bool
+  CarriedAlongFans(const double * x0, const double * y, TParallel && parallel)
+  {
+    const SizeValueType n = m_NumberOfPoints;
+    uint8_t *           flags = m_CarriedFar.data();
+    // Eight flags at a time: most words are 0.
+    std::vector<IndexType> & farPoints = m_CarriedFarPoints;
+    farPoints.clear();
+    SizeValueType i = 0;
+    for (; i + 8 <= n; i += 8)
+    {
+      uint64_t word;
+      std::memcpy(&word, flags + i, sizeof(word));
+      if (word == 0)
+      {
+        continue;
+      }
+      for (SizeValueType j = i; j < i + 8; ++j)
+      {
+        if (flags[j] != 0)
+        {
+          farPoints.push_back(static_cast<IndexType>(j));
+        }
+      }
+    }
+    for (; i < n; ++i)
+    {
+      if (flags[i] != 0)
+      {
+        farPoints.push_back(static_cast<IndexType>(i));
+      }
+    }
+    if (!m_PointLimitsReady)
+    {
+      m_PointLimits.assign(n, -1.0);
+      m_PointLimitsReady = true;
+    }
+    const SizeValueType     count = farPoints.size();
+    constexpr SizeValueType block = SurfaceCollisionDetail::ParallelBlocks::Block;
+    const IndexType *       offsets = m_FanOffsets;
+    const IndexType *       neighbours = m_FanNeighbours;
+    // The points' own margins: flag 2 for a point beyond its own.
+    std::vector<SizeValueType> notCleared((count + block - 1) / block, 0);
+    parallel(count, [&](SizeValueType begin, SizeValueType end) {
+      for (SizeValueType k = begin; k < end; ++k)
+      {
+        const IndexType p = farPoints[k];
+        double &        limit = m_PointLimits[p];
+        if (limit < 0.0)
+        {
+          const SizeValueType first = offsets[p];
+          const SizeValueType last = offsets[p + 1];
+          double              least = std::numeric_limits<double>::infinity();
+          for (SizeValueType j = first; j < last && least > 0.0; ++j)
+          {
+            const IndexType vt[3] = { p, neighbours[j], neighbours[j + 1 < last ? j + 1 : first] };
+            least = std::min(least, this->OwnMarginLimit(x0, vt));
+          }
+          limit = least < std::numeric_limits<double>::infinity() ? least : 0.0;
+        }
+        if (!(limit > 0.0 && SquaredDistance(x0, y, p) <= limit)) // NaN: not cleared
+        {
+          flags[p] = 2;
+          ++notCleared[begin / block];
+        }
+      }
+    });
+    const SizeValueType beyond = std::accumulate(notCleared.begin(), notCleared.end(), SizeValueType{ 0 });
+    m_TotalNumberOfPointsWithinOwnMargin += count - beyond;
+    if (beyond == 0)
+    {
+      return true;
+    }
+    std::vector<uint8_t>       turned((count + block - 1) / block, 0);
+    std::vector<SizeValueType> ownMargins(turned.size(), 0);
+    parallel(count, [&](SizeValueType begin, SizeValueType end) {
+      for (SizeValueType k = begin; k < end; ++k)
+      {
+        const IndexType p = farPoints[k];
+        if (flags[p] != 2)
         {
           continue;
         }
-        if (this->WithinOwnMargin(x0, y, vt))
+        const SizeValueType first = offsets[p];
+        const SizeValueType last = offsets[p + 1];
+        for (SizeValueType j = first; j < last; ++j)
         {
-          ++ownMargins[begin / block];
-          continue;
-        }
-        const double * ends[3][2];
-        for (unsigned int k = 0; k < 3; ++k)
-        {
-          ends[k][0] = x0 + 3 * static_cast<SizeValueType>(vt[k]);
-          ends[k][1] = y + 3 * static_cast<SizeValueType>(vt[k]);
-        }
-        for (unsigned int choice = 1; choice < 8; ++choice)
-        {
-          if (SurfaceCollisionDetail::Orient3DSign(
-                m_CarriedCentre, ends[0][choice & 1], ends[1][(choice >> 1) & 1], ends[2][(choice >> 2) & 1]) !=
-              m_CarriedSign)
+          const IndexType a = neighbours[j];
+          const IndexType b = neighbours[j + 1 < last ? j + 1 : first];
+          if ((flags[a] == 2 && a < p) || (flags[b] == 2 && b < p))
+          {
+            continue; // tested from its first point not cleared
+          }
+          const IndexType vt[3] = { p, a, b };
+          if (!this->KeepsCarriedOrientation(x0, y, vt, true, ownMargins[begin / block]))
           {
             turned[begin / block] = 1;
             return;
@@ -4830,8 +5029,19 @@ private:
   int                  m_CarriedSign{ 0 };                  // the orientation of its triangles seen from it
   double               m_CarriedRounding{ 0.0 };            // StarShaped()'s bound of the determinants' rounding
   SizeValueType        m_TotalNumberOfTrianglesWithinOwnMargin{ 0 };
+  SizeValueType        m_TotalNumberOfPointsWithinOwnMargin{ 0 };
   std::vector<uint8_t> m_CarriedFar; // CarriedTo(): per point, beyond the margin
-  SizeValueType        m_TotalNumberOfCarriedCertificates{ 0 };
+  // SetPointFans(): the caller's fans (not owned), and CarriedTo()'s list of
+  // the points beyond the margin.
+  const IndexType *      m_FanOffsets{ nullptr };
+  const IndexType *      m_FanNeighbours{ nullptr };
+  std::vector<IndexType> m_CarriedFarPoints;
+  // CarriedAlongFans(): per point, the square of the least own margin of its
+  // triangles (OwnMarginLimit()), computed when the point first goes beyond
+  // the carried margin (negative until then), for the carried certificate.
+  std::vector<double> m_PointLimits;
+  bool                m_PointLimitsReady{ false };
+  SizeValueType       m_TotalNumberOfCarriedCertificates{ 0 };
   // CarryNow(): the steps certified by the last carried margin, whether one
   // was computed since the last decision, and the wait before the next.
   SizeValueType m_CarryYield{ 0 };

@@ -1319,6 +1319,165 @@ TEST(SurfaceCollision, TheCertificateFollowsTheTrianglesOfPointsBeyondItsMargin)
   EXPECT_GT(nearCarried, 60u);
 }
 
+// Each point's neighbours in the cyclic order of its triangles (i, r_k,
+// r_k+1), chained from the triangles' own orders: the fans that
+// SetPointFans() takes (DeformableMeshFilter passes its rings).
+namespace
+{
+void
+PointFans(const std::vector<uint32_t> & triangles,
+          std::size_t                   n,
+          std::vector<uint32_t> &       offsets,
+          std::vector<uint32_t> &       neighbours)
+{
+  std::vector<std::vector<std::pair<uint32_t, uint32_t>>> pairs(n);
+  for (std::size_t c = 0; c < triangles.size(); c += 3)
+  {
+    for (unsigned int k = 0; k < 3; ++k)
+    {
+      pairs[triangles[c + k]].emplace_back(triangles[c + (k + 1) % 3], triangles[c + (k + 2) % 3]);
+    }
+  }
+  offsets.assign(1, 0);
+  neighbours.clear();
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const auto & fan = pairs[i];
+    if (!fan.empty())
+    {
+      uint32_t next = fan.front().first;
+      for (std::size_t k = 0; k < fan.size(); ++k)
+      {
+        neighbours.push_back(next);
+        const auto pair = std::find_if(
+          fan.begin(), fan.end(), [next](const std::pair<uint32_t, uint32_t> & p) { return p.first == next; });
+        next = pair->second;
+      }
+    }
+    offsets.push_back(static_cast<uint32_t>(neighbours.size()));
+  }
+}
+} // namespace
+
+TEST(SurfaceCollision, PointFansGiveTheScanDecisions)
+{
+  // The carried certificate through the fans of the points beyond its
+  // margin (SetPointFans(): their own margins, then the triangles of those
+  // beyond them) decides as the pass over all the triangles: the same
+  // steps carried, the same positions, from a jittered sphere with 1 to 8
+  // points moved by 1 to 10 carried margins, or through the sphere. Every
+  // step carried is star-shaped by a fresh certificate and free of
+  // intersecting pairs by the test of all pairs. Some points are cleared by
+  // their own margins, and some are not (their triangles tested).
+  std::vector<double>   x;
+  std::vector<uint32_t> triangles;
+  StarSphere(x, triangles);
+  const std::size_t     n = x.size() / 3;
+  const std::size_t     numberOfTriangles = triangles.size() / 3;
+  std::vector<uint32_t> offsets;
+  std::vector<uint32_t> neighbours;
+  PointFans(triangles, n, offsets, neighbours);
+  ASSERT_EQ(offsets.back(), triangles.size());
+  std::mt19937                     random(20261207);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (double & v : x)
+  {
+    v += 0.05 * 1.1 * normal(random) / std::sqrt(3.0);
+  }
+  std::size_t carried = 0;
+  std::size_t otherwise = 0;
+  std::size_t pointsCleared = 0;
+  std::size_t trianglesTested = 0;
+  for (int trial = 0; trial < 240; ++trial)
+  {
+    itk::SurfaceCollision withFans;
+    itk::SurfaceCollision scanning;
+    for (itk::SurfaceCollision * collision : { &withFans, &scanning })
+    {
+      collision->SetSurface(n, triangles.data(), numberOfTriangles);
+      std::vector<double> y = x;
+      ASSERT_EQ(collision->Constrain(x.data(), y.data(), 0.0, nullptr, 1).constrained, 0u);
+      ASSERT_GT(collision->GetCarriedMargin(), 0.0);
+    }
+    ASSERT_EQ(withFans.GetCarriedMargin(), scanning.GetCarriedMargin());
+    const double                               margin = withFans.GetCarriedMargin();
+    std::uniform_int_distribution<std::size_t> pick(0, n - 1);
+    std::vector<double>                        y = x;
+    const std::size_t                          moved = 1 + static_cast<std::size_t>(trial) % 8;
+    const bool                                 through = trial % 10 == 9;
+    for (std::size_t m = 0; m < moved; ++m)
+    {
+      const std::size_t i = pick(random);
+      if (through && m == 0)
+      {
+        const double centre[3] = { 1.3, -0.7, 2.1 };
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          y[3 * i + d] = centre[d] - 1.5 * (x[3 * i + d] - centre[d]);
+        }
+        continue;
+      }
+      double       v[3] = { normal(random), normal(random), normal(random) };
+      const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      const double distance = margin * (1.0 + 9.0 * static_cast<double>(trial % 23) / 22.0);
+      for (unsigned int d = 0; d < 3; ++d)
+      {
+        y[3 * i + d] = x[3 * i + d] + distance * v[d] / length;
+      }
+    }
+    std::vector<double> yFans = y;
+    std::vector<double> yScan = y;
+    const std::size_t   cleared = withFans.GetTotalNumberOfPointsWithinOwnMargin();
+    const std::size_t   tested = withFans.GetTotalNumberOfTrianglesWithinOwnMargin();
+    withFans.SetPointFans(offsets.data(), neighbours.data());
+    withFans.Constrain(x.data(), yFans.data(), 0.0, nullptr, 1);
+    withFans.SetPointFans(nullptr, nullptr);
+    scanning.Constrain(x.data(), yScan.data(), 0.0, nullptr, 1);
+    pointsCleared += withFans.GetTotalNumberOfPointsWithinOwnMargin() - cleared;
+    trianglesTested += withFans.GetTotalNumberOfTrianglesWithinOwnMargin() - tested;
+    const bool carriedNow = withFans.GetTotalNumberOfCarriedCertificates() > 0;
+    EXPECT_EQ(carriedNow, scanning.GetTotalNumberOfCarriedCertificates() > 0) << "trial " << trial;
+    EXPECT_EQ(yFans, yScan) << "trial " << trial;
+    EXPECT_EQ(CheckAllPairs(yFans, triangles, 0.0).intersecting, 0u) << "trial " << trial;
+    if (carriedNow)
+    {
+      EXPECT_FALSE(through) << "trial " << trial << ": a point through the sphere carried";
+      itk::SurfaceCollision fresh;
+      fresh.SetSurface(n, triangles.data(), numberOfTriangles);
+      EXPECT_TRUE(fresh.IsStarShaped(yFans.data())) << "trial " << trial;
+    }
+    carried += carriedNow ? 1 : 0;
+    otherwise += carriedNow ? 0 : 1;
+  }
+  std::cout << carried << " steps carried, " << otherwise << " decided otherwise; " << pointsCleared
+            << " points cleared by their own margins, " << trianglesTested
+            << " triangles of the others kept by their own margins" << std::endl;
+  EXPECT_GT(carried, 50u);
+  EXPECT_GT(otherwise, 24u);
+  EXPECT_GT(pointsCleared, 20u);
+  EXPECT_GT(trianglesTested, 20u);
+
+  // Fans that cannot describe the triangles (not three corners a triangle)
+  // are ignored; SetSurface() drops the fans.
+  itk::SurfaceCollision collision;
+  collision.SetSurface(n, triangles.data(), numberOfTriangles);
+  std::vector<double> y = x;
+  ASSERT_EQ(collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1).constrained, 0u);
+  std::vector<uint32_t> short_ = offsets;
+  short_.back() -= 1;
+  y[0] += 3.0 * collision.GetCarriedMargin();
+  collision.SetPointFans(short_.data(), neighbours.data());
+  collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1);
+  EXPECT_EQ(collision.GetTotalNumberOfPointsWithinOwnMargin(), 0u);
+  collision.SetPointFans(offsets.data(), neighbours.data());
+  collision.SetSurface(n, triangles.data(), numberOfTriangles);
+  y = x;
+  ASSERT_EQ(collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1).constrained, 0u);
+  y[0] += 3.0 * collision.GetCarriedMargin();
+  collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1);
+  EXPECT_EQ(collision.GetTotalNumberOfPointsWithinOwnMargin(), 0u);
+}
+
 TEST(SurfaceCollision, TheCertificateTakesFoldsThatMeetNothing)
 {
   std::vector<double>   x;
