@@ -643,6 +643,15 @@ public:
   {
     return m_Collision.GetTotalNumberOfCarriedCertificates();
   }
+  /** How many times a point that had left a carried certificate's margin
+   * was found within its own (the least own margin of its triangles), so
+   * that its triangles needed no test: after a remeshing, where the
+   * filter's rings lead to them (SurfaceCollision::SetPointFans()). */
+  SizeValueType
+  GetNumberOfPointsWithinOwnCarriedMargin() const
+  {
+    return m_Collision.GetTotalNumberOfPointsWithinOwnMargin();
+  }
   SizeValueType
   GetNumberOfCollisionIndexRebuilds() const
   {

@@ -2179,6 +2179,41 @@ TEST(SurfaceCollision, RemeshingDuringTheShrinkWrapNeverBringsFrontsCloserThanD)
             << " points at the end" << std::endl;
 }
 
+TEST(SurfaceCollision, TheFilterCarriesItsCertificateThroughItsRings)
+{
+  // The shrink-wrap's first 60 iterations, deflating slowly (balloon -0.03
+  // mm per iteration), with MinimumDistance 0 and remeshing to the initial
+  // edge length (2.7 mm) every 10 iterations: the surface stays star-shaped
+  // from its centroid, the certificate carries from step to step (at -0.25
+  // mm an iteration the points leave its margin at once: 1 step carried of
+  // 66), and after each remeshing the filter's rings lead to
+  // the triangles of the points beyond the carried margin, some of them
+  // cleared by their own margins. No intersecting pair at any iteration
+  // (brute force).
+  const ShrinkWrap      wrap;
+  auto                  filter = wrap.MakeFilter(true, 0.0, 60);
+  std::vector<double>   x;
+  std::vector<uint32_t> triangles;
+  std::size_t           worstIntersecting = 0;
+  filter->SetBalloon(-0.03);
+  filter->SetRemeshingEdgeLength(2.7);
+  filter->SetRemeshingInterval(10);
+  ObserveIterations(filter.GetPointer(), [&] {
+    Flatten(filter->GetOutput(), x, triangles);
+    const std::size_t intersecting = CheckAllPairs(x, triangles, 0.0).intersecting;
+    worstIntersecting = std::max(worstIntersecting, intersecting);
+    EXPECT_EQ(intersecting, 0u) << "iteration " << filter->GetCurrentIteration();
+  });
+  std::cout << filter->GetNumberOfCertifiedSteps() << " steps certified, " << filter->GetNumberOfCarriedCertificates()
+            << " carried, " << filter->GetNumberOfPointsWithinOwnCarriedMargin()
+            << " points cleared by their own margins, " << filter->GetNumberOfCollisionIndexRebuilds()
+            << " index builds" << std::endl;
+  EXPECT_EQ(filter->GetNumberOfRemeshings(), 6u);
+  EXPECT_EQ(worstIntersecting, 0u);
+  EXPECT_GT(filter->GetNumberOfCarriedCertificates(), 0u);
+  EXPECT_GT(filter->GetNumberOfPointsWithinOwnCarriedMargin(), 0u);
+}
+
 TEST(SurfaceCollision, ASurfaceHeldAgainstItselfConverges)
 {
   // The shrink-wrap with prevention (d = 0.3 mm) rests in the crease over
