@@ -1073,14 +1073,19 @@ DeformableMeshFilter<TMesh, TForceImage>::ConstrainSelfIntersections(std::vector
   const std::vector<double> & start = m_NumberOfSubSteps > 1 ? m_IterationStart : this->GetCoordinates();
   // A closed surface's fans, built from the collision test's own
   // triangles (the remeshed m_Triangles): a carried certificate visits the
-  // triangles of the points that moved beyond its margin through them.
+  // triangles of the points that moved beyond its margin through them. Lent
+  // for this call only (also when it throws).
+  struct LentFans
+  {
+    SurfaceCollision & collision;
+    ~LentFans() { collision.SetPointFans(nullptr, nullptr); }
+  } lent{ m_Collision };
   if (m_ClosedFans && m_CollisionTrianglesAreMeshTriangles)
   {
     m_Collision.SetPointFans(m_NeighbourOffsets.data(), m_Neighbours.data());
   }
   const auto result = m_Collision.Constrain(
     start.data(), m_NextCoordinates.data(), m_MinimumDistance, this->GetMultiThreader(), this->GetNumberOfWorkUnits());
-  m_Collision.SetPointFans(nullptr, nullptr);
   m_NumberOfCollisionsPrevented = result.violations;
   m_TotalNumberOfCollisionsPrevented += result.violations;
   m_NumberOfConstrainedVertices = result.constrained;
