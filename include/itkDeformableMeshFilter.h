@@ -877,7 +877,7 @@ private:
   RenumberRemeshed(std::vector<double> & x);
   /** Moves point order[k] of \a x (3 coordinates a point, the first
    * order.size() points) to k; returns the new number of each point. */
-  static std::vector<IndexType32>
+  std::vector<IndexType32>
   ApplyOrder(std::vector<double> & x, const std::vector<IndexType32> & order);
   void
   RemeshWithoutContacts(const std::vector<double> & x, const std::vector<IndexType32> & triangles);
