@@ -2185,6 +2185,11 @@ public:
           this->EnsureSpecialGrid();
         }
       }
+      m_InRound.resize(numberOfTriangles, 0);
+      for (const IndexType t : triangles)
+      {
+        m_InRound[t] = 1;
+      }
       const SizeValueType                                       roundBlocks = (triangles.size() + 1023) / 1024;
       std::vector<std::vector<std::pair<IndexType, IndexType>>> roundFound(roundBlocks);
       parallel(triangles.size(), [&](SizeValueType begin, SizeValueType end) {
@@ -2201,7 +2206,10 @@ public:
           };
           if (sweptBounded)
           {
-            this->ForEachBoundedPartner(t, d, test);
+            // A candidate pair of two triangles of this round is tested
+            // once, from the lower one (in a wide contact both sides of
+            // most pairs are held back: each was tested twice).
+            this->ForEachBoundedPartner(t, d, test, [this, t](IndexType u) { return u < t && m_InRound[u] != 0; });
           }
           else
           {
@@ -2222,6 +2230,10 @@ public:
           }
         }
       });
+      for (const IndexType t : triangles)
+      {
+        m_InRound[t] = 0;
+      }
       for (const auto & block : roundFound)
       {
         violating.insert(violating.end(), block.begin(), block.end());
@@ -2615,16 +2627,19 @@ private:
    * the boxes of the last Bound() (which held): t's candidates whose pair
    * bound does not clear them and, when there are large triangles and t's
    * motion may reach R - d, the pairs of t with a large triangle found in
-   * the reference grid. Other pairs are kept apart by the cells' bounds. */
-  template <typename TFunction>
+   * the reference grid. Other pairs are kept apart by the cells' bounds.
+   * The candidates u for which skipCandidate(u) holds are left out (the
+   * candidate lists are symmetric: the caller tests those pairs from u). */
+  template <typename TFunction, typename TSkip>
   void
-  ForEachBoundedPartner(SizeValueType t, double d, TFunction && f)
+  ForEachBoundedPartner(SizeValueType t, double d, TFunction && f, TSkip && skipCandidate)
   {
     const float * bt = m_TriangleDelta.data() + 6 * t;
     for (SizeValueType c = m_CandidateOffsets[t]; c < m_CandidateOffsets[t + 1]; ++c)
     {
       const IndexType u = m_Candidates[c];
-      if (LargestDistance(bt, m_TriangleDelta.data() + 6 * u) < static_cast<double>(m_CandidateGaps[c]) - d)
+      if (skipCandidate(u) ||
+          LargestDistance(bt, m_TriangleDelta.data() + 6 * u) < static_cast<double>(m_CandidateGaps[c]) - d)
       {
         continue;
       }
@@ -5062,6 +5077,7 @@ private:
   std::vector<IndexType>          m_CandidateOffsets;
   std::vector<IndexType>          m_Candidates;     // both directions
   std::vector<float>              m_CandidateGaps;  // lower bound of the distance at the reference, rounded down
+  std::vector<uint8_t>            m_InRound;        // scratch of Constrain(): the triangles of a halving round
   std::vector<uint8_t>            m_CandidateExact; // the gap is the exact distance
   std::vector<float>              m_Clearance;      // per triangle
   std::vector<CellLevel>          m_Levels;
