@@ -681,8 +681,9 @@ private:
   };
   std::vector<uint8_t>   m_Touched;
   std::vector<uint8_t>   m_RelaxSet;
-  std::vector<IndexType> m_FlipSeeds;  // scratch of FlipPass(), incremental: the touched points
-  std::vector<uint64_t>  m_FlipMarked; // scratch of FlipPass(), incremental: the corners to test
+  std::vector<IndexType> m_FlipSeeds;        // scratch of FlipPass(), incremental: the touched points
+  std::vector<uint64_t>  m_FlipMarked;       // scratch of FlipPass(), incremental: the corners to test
+  std::vector<uint64_t>  m_FlipMarkedSecond; // the same, from the second half of the touched points
   bool                   m_Local{ false };
   std::vector<IndexType> m_SplitTouched;     // triangles the splits of a pass changed or made
   std::vector<uint64_t>  m_SplitTouchedBits; // scratch of SplitPass(): m_SplitTouched, a bit per triangle
@@ -1996,44 +1997,69 @@ DeformableMeshRemesher::FlipPass()
     scan();
     return;
   }
+  // The corners marked in two halves of the touched points in parallel,
+  // each into its own bits, or-ed after (a set: the order does not
+  // matter), then tested in parallel word by word (each word of the queue
+  // written by one thread): 10 to 20 ms an update in series at a million
+  // points at rest.
   const std::size_t       words = (numberOfCorners + 63) / 64;
   std::vector<uint64_t> & marked = m_FlipMarked;
+  std::vector<uint64_t> & markedSecond = m_FlipMarkedSecond;
   marked.assign(words, 0);
-  std::vector<IndexType> & ring = m_SerialWorker.ringA;
-  std::vector<IndexType> & corners = m_SerialWorker.cornersA;
-  for (const IndexType v : touched)
-  {
-    if (!this->Ring(v, ring, &corners))
+  markedSecond.assign(words, 0);
+  bool walked[2] = { true, true };
+  this->Halves([&](std::size_t part) {
+    std::vector<uint64_t> & bits = part == 0 ? marked : markedSecond;
+    std::vector<IndexType>  ring;
+    std::vector<IndexType>  corners;
+    const std::size_t       half = touched.size() / 2;
+    for (std::size_t k = part == 0 ? 0 : half; k < (part == 0 ? half : touched.size()); ++k)
     {
-      scan(); // a fan that cannot be walked
-      return;
-    }
-    for (const IndexType k : corners)
-    {
-      const IndexType first = k - k % 3;
-      for (IndexType c = first; c < first + 3; ++c)
+      if (!this->Ring(touched[k], ring, &corners))
       {
-        marked[c >> 6] |= uint64_t{ 1 } << (c & 63);
-        const Link o = m_O[c];
-        if (o >= 0)
+        walked[part] = false; // a fan that cannot be walked
+        return;
+      }
+      for (const IndexType corner : corners)
+      {
+        const IndexType triangle = corner - corner % 3;
+        for (IndexType c = triangle; c < triangle + 3; ++c)
         {
-          marked[static_cast<std::size_t>(o) >> 6] |= uint64_t{ 1 } << (o & 63);
+          bits[c >> 6] |= uint64_t{ 1 } << (c & 63);
+          const Link o = m_O[c];
+          if (o >= 0)
+          {
+            bits[static_cast<std::size_t>(o) >> 6] |= uint64_t{ 1 } << (o & 63);
+          }
         }
       }
     }
+  });
+  if (!walked[0] || !walked[1])
+  {
+    scan();
+    return;
   }
   m_Queue.assign(words, 0);
-  for (std::size_t w = 0; w < words; ++w)
-  {
-    for (uint64_t bits = marked[w]; bits != 0; bits &= bits - 1)
-    {
-      const auto c = static_cast<IndexType>(64 * w + LowestBit(bits));
-      if (m_V[c] != Invalid && this->FlipImprovesValences(c, true))
+  this->ParallelFor(
+    words,
+    [&](std::size_t first, std::size_t last) {
+      for (std::size_t w = first; w < last; ++w)
       {
-        m_Queue[w] |= uint64_t{ 1 } << (c & 63);
+        uint64_t queued = 0;
+        for (uint64_t bits = marked[w] | markedSecond[w]; bits != 0; bits &= bits - 1)
+        {
+          const unsigned int bit = LowestBit(bits);
+          const auto         c = static_cast<IndexType>(64 * w + bit);
+          if (m_V[c] != Invalid && this->FlipImprovesValences(c, true))
+          {
+            queued |= uint64_t{ 1 } << bit;
+          }
+        }
+        m_Queue[w] = queued;
       }
-    }
-  }
+    },
+    1024);
   this->RunQueue(SweepInputs::Valences, body);
 }
 
