@@ -14,8 +14,8 @@
 #                      (for a build through ITKModuleExternal).
 # EDM_ITK_WRAP_PYTHON=ON (with MODULE_SOURCE_DIR): ITK's Python wrapping
 #   (ITK_WRAP_PYTHON, Debian's castxml and swig) of the module and of only the
-#   ITK modules it depends on, for 3-D images and meshes of the default pixel
-#   types without RGB, RGBA, complex and signed short (scripts/ci-itk-python.sh).
+#   ITK modules it depends on, for 3-D images and meshes of float pixels (no
+#   unsigned char, signed short, RGB, RGBA or complex: scripts/ci-itk-python.sh).
 #
 # Trees are cached between runs under $EDM_ITK_CACHE (default
 # /var/cache/edm-itk), in a directory named by the version, the kind of tree
@@ -87,7 +87,7 @@ if [ "$wrap_python" = ON ]; then
   options=$(echo "$options" | sed 's/-DITK_WRAP_PYTHON=OFF//; s/-DModule_[A-Za-z0-9]*=ON//g')
   options="$options -DITKGroup_Core=OFF -DModule_ExplicitDeformableModel=ON -DITK_WRAP_PYTHON=ON
     -DITK_USE_SYSTEM_CASTXML=ON -DITK_USE_SYSTEM_SWIG=ON -DPython3_EXECUTABLE=/usr/bin/python3
-    -DITK_WRAP_IMAGE_DIMS=3 -DITK_WRAP_signed_short=OFF -DITK_WRAP_rgb_unsigned_char=OFF
+    -DITK_WRAP_IMAGE_DIMS=3 -DITK_WRAP_unsigned_char=OFF -DITK_WRAP_signed_short=OFF -DITK_WRAP_rgb_unsigned_char=OFF
     -DITK_WRAP_rgba_unsigned_char=OFF -DITK_WRAP_complex_float=OFF"
 elif [ -n "$module_dir" ]; then
   kind=intree
