@@ -605,6 +605,22 @@ public:
   itkSetMacro(MinimumDistance, double);
   itkGetConstMacro(MinimumDistance, double);
 
+  /** Contact memory, with PreventSelfIntersections: a vertex whose
+   * displacement the collision test reduced moves, at the next iterations,
+   * by a fraction of the displacement the step proposes: the fraction the
+   * test let it keep (1/2, 1/4 or 0, times its previous fraction), doubled
+   * at each iteration in which the test does not reduce it again (from 1/8
+   * when it was 0) until it is 1. A front that the forces keep pushing
+   * against another then proposes little into it, and the test does not
+   * halve the whole contact zone again at every iteration: on the ch2bet
+   * brain with a wide contact (edmodel --sigma 2) the finest level took half
+   * the time, with the same accuracy. The test still decides every step, so
+   * the guarantee (no intersection, MinimumDistance) is the same. Reset and
+   * remeshing: a new vertex takes its parent's fraction. Default: on. */
+  itkSetMacro(RememberContacts, bool);
+  itkGetConstMacro(RememberContacts, bool);
+  itkBooleanMacro(RememberContacts);
+
   /** Per-vertex damping of displacements that reverse the previous one
    * (see the class documentation). Off by default. */
   itkSetMacro(DampOscillations, bool);
@@ -619,7 +635,8 @@ public:
    * triangles found violating the constraint in the last iteration (each
    * time one is found: a pair still violating after its displacements were
    * halved counts again), the same summed over the iterations since the last
-   * reset, and the vertices whose displacement the last iteration reduced. */
+   * reset, and the vertices whose displacement the last iteration reduced
+   * (by the test, or by RememberContacts). */
   itkGetConstMacro(NumberOfCollisionsPrevented, SizeValueType);
   itkGetConstMacro(TotalNumberOfCollisionsPrevented, SizeValueType);
   itkGetConstMacro(NumberOfConstrainedVertices, SizeValueType);
@@ -1029,6 +1046,14 @@ private:
   SizeValueType                     m_NumberOfCollisionsPrevented{ 0 };
   SizeValueType                     m_TotalNumberOfCollisionsPrevented{ 0 };
   SizeValueType                     m_NumberOfConstrainedVertices{ 0 };
+  /** Contact memory (PreventSelfIntersections): per vertex, the fraction of
+   * its proposed displacement it may move (1 unless a contact held it back
+   * lately); the vertices below 1, in increasing order; their proposals of
+   * the current iteration. */
+  bool                     m_RememberContacts{ true };
+  std::vector<float>       m_ContactFactors;
+  std::vector<IndexType32> m_HeldPoints;
+  std::vector<double>      m_HeldProposals;
   /** The collision test's tables and index (PreventSelfIntersections). */
   SurfaceCollision m_Collision;
   /** The triangles last given to ResetCollision() (empty: the input's),

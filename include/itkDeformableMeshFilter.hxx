@@ -964,6 +964,8 @@ DeformableMeshFilter<TMesh, TForceImage>::Reset()
   m_LastMaximumDisplacement = 0.0;
   m_OscillationState.clear();
   m_NumberOfDampedVertices = 0;
+  m_ContactFactors.clear();
+  m_HeldPoints.clear();
   m_NormalSpeeds.clear();
   m_EdgeHits.clear();
   m_NumberOfEdgeHits = 0;
@@ -1084,28 +1086,117 @@ DeformableMeshFilter<TMesh, TForceImage>::ConstrainSelfIntersections(std::vector
   {
     m_Collision.SetPointFans(m_NeighbourOffsets.data(), m_Neighbours.data());
   }
+  const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
+  // Contact memory: a vertex that a contact held back moves by a fraction of
+  // its proposal at the next iterations (its factor, doubled at each
+  // iteration it is not held again, from 1/8 when it was zeroed, until 1).
+  // A front resting against another then proposes little into it, and the
+  // test's halving rounds do not spread over the whole contact again at
+  // every iteration. The test below still decides; the held vertices'
+  // proposals are kept for the convergence counts.
+  if (!m_RememberContacts)
+  {
+    m_ContactFactors.clear();
+    m_HeldPoints.clear();
+  }
+  else if (m_ContactFactors.size() != numberOfPoints)
+  {
+    m_ContactFactors.assign(numberOfPoints, 1.0f);
+    m_HeldPoints.clear();
+  }
+  m_HeldProposals.resize(3 * m_HeldPoints.size());
+  for (SizeValueType k = 0; k < m_HeldPoints.size(); ++k)
+  {
+    const SizeValueType i = m_HeldPoints[k];
+    const double        f = m_ContactFactors[i];
+    for (unsigned int c = 0; c < 3; ++c)
+    {
+      double & q = m_NextCoordinates[3 * i + c];
+      m_HeldProposals[3 * k + c] = q;
+      q = start[3 * i + c] + f * (q - start[3 * i + c]);
+    }
+  }
   const auto result = m_Collision.Constrain(
     start.data(), m_NextCoordinates.data(), m_MinimumDistance, this->GetMultiThreader(), this->GetNumberOfWorkUnits());
   m_NumberOfCollisionsPrevented = result.violations;
   m_TotalNumberOfCollisionsPrevented += result.violations;
   m_NumberOfConstrainedVertices = result.constrained;
-  if (result.constrained == 0)
+  if (result.constrained == 0 && m_HeldPoints.empty())
   {
     return;
   }
-  // The displacements of the constrained vertices changed: their
-  // diagnostics, and the largest displacement (a pass over the vertices, in
-  // the iterations that constrain some only).
-  const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
-  const auto          length = [&](SizeValueType i) {
-    const double dx = m_NextCoordinates[3 * i] - start[3 * i];
-    const double dy = m_NextCoordinates[3 * i + 1] - start[3 * i + 1];
-    const double dz = m_NextCoordinates[3 * i + 2] - start[3 * i + 2];
-    return std::sqrt(dx * dx + dy * dy + dz * dz);
+  const auto squaredLength = [&](SizeValueType i, const double * p) {
+    const double dx = p[0] - start[3 * i];
+    const double dy = p[1] - start[3 * i + 1];
+    const double dz = p[2] - start[3 * i + 2];
+    return dx * dx + dy * dy + dz * dz;
   };
+  const auto length = [&](SizeValueType i) { return std::sqrt(squaredLength(i, m_NextCoordinates.data() + 3 * i)); };
+  // The proposal of the step (before the contact memory and the test) of a
+  // vertex the test held back.
+  const auto &             constrainedPoints = m_Collision.GetConstrainedPoints();
+  const auto &             constrainedProposals = m_Collision.GetConstrainedProposals();
+  std::vector<IndexType32> previous;
+  previous.swap(m_HeldPoints);
+  // The factors of the next iteration: the vertices held now keep the part
+  // of their proposal the test let them move; the others recover.
+  std::vector<IndexType32> constrainedSorted(constrainedPoints.begin(), constrainedPoints.end());
+  std::sort(constrainedSorted.begin(), constrainedSorted.end());
+  const auto constrainedNow = [&constrainedSorted](IndexType32 i) {
+    return std::binary_search(constrainedSorted.begin(), constrainedSorted.end(), i);
+  };
+  SizeValueType reduced = constrainedSorted.size();
+  for (const IndexType32 i : previous)
+  {
+    reduced += !constrainedNow(i);
+  }
+  m_NumberOfConstrainedVertices = reduced;
+  if (m_RememberContacts)
+  {
+    std::vector<IndexType32> nowHeld;
+    nowHeld.reserve(constrainedPoints.size() + previous.size());
+    for (SizeValueType k = 0; k < constrainedPoints.size(); ++k)
+    {
+      const SizeValueType i = constrainedPoints[k];
+      const double        proposed = squaredLength(i, constrainedProposals.data() + 3 * k);
+      const double        kept = squaredLength(i, m_NextCoordinates.data() + 3 * i);
+      const double        ratio = proposed > 0.0 ? std::sqrt(kept / proposed) : 1.0;
+      m_ContactFactors[i] = static_cast<float>(m_ContactFactors[i] * std::min(1.0, ratio));
+      if (m_ContactFactors[i] < 1.0f)
+      {
+        nowHeld.push_back(static_cast<IndexType32>(i));
+      }
+    }
+    for (const IndexType32 i : previous)
+    {
+      if (constrainedNow(i))
+      {
+        continue;
+      }
+      float & f = m_ContactFactors[i];
+      f = f < 0.125f ? 0.125f : 2.0f * f;
+      if (f >= 1.0f)
+      {
+        f = 1.0f;
+      }
+      else
+      {
+        nowHeld.push_back(i);
+      }
+    }
+    std::sort(nowHeld.begin(), nowHeld.end());
+    m_HeldPoints.swap(nowHeld);
+  }
+  // The displacements of the held and constrained vertices changed: their
+  // diagnostics, and the largest displacement (a pass over the vertices, in
+  // the iterations that hold some only).
   if (diagnose)
   {
-    for (const auto i : m_Collision.GetConstrainedPoints())
+    for (const auto i : constrainedPoints)
+    {
+      m_DisplacementMagnitudes[i] = static_cast<float>(length(i));
+    }
+    for (const auto i : previous)
     {
       m_DisplacementMagnitudes[i] = static_cast<float>(length(i));
     }
@@ -1137,17 +1228,27 @@ DeformableMeshFilter<TMesh, TForceImage>::ConstrainSelfIntersections(std::vector
     const double along = d[0] * normals[4 * i] + d[1] * normals[4 * i + 1] + d[2] * normals[4 * i + 2];
     return along * along;
   };
-  const double                squaredTolerance = m_ConvergenceTolerance * m_ConvergenceTolerance;
-  const auto &                points = m_Collision.GetConstrainedPoints();
-  const std::vector<double> & proposals = m_Collision.GetConstrainedProposals();
-  for (SizeValueType k = 0; k < points.size(); ++k)
-  {
-    const SizeValueType i = points[k];
-    const bool          was = measured(i, proposals.data() + 3 * k) >= squaredTolerance;
-    const bool          is = measured(i, m_NextCoordinates.data() + 3 * i) >= squaredTolerance;
+  const double squaredTolerance = m_ConvergenceTolerance * m_ConvergenceTolerance;
+  // Each vertex whose displacement changed once: from its proposal (before
+  // the contact memory) to where it goes.
+  const auto recount = [&](SizeValueType i, const double * proposal) {
+    const bool was = measured(i, proposal) >= squaredTolerance;
+    const bool is = measured(i, m_NextCoordinates.data() + 3 * i) >= squaredTolerance;
     if (was && !is && m_NumberOfActiveVertices > 0)
     {
       --m_NumberOfActiveVertices;
+    }
+  };
+  for (SizeValueType k = 0; k < previous.size(); ++k)
+  {
+    recount(previous[k], m_HeldProposals.data() + 3 * k);
+  }
+  for (SizeValueType k = 0; k < constrainedPoints.size(); ++k)
+  {
+    const SizeValueType i = constrainedPoints[k];
+    if (!std::binary_search(previous.begin(), previous.end(), static_cast<IndexType32>(i)))
+    {
+      recount(i, constrainedProposals.data() + 3 * k);
     }
   }
   if (normals != nullptr)
@@ -1727,6 +1828,20 @@ DeformableMeshFilter<TMesh, TForceImage>::Remesh()
   };
   remap(m_BalloonReleased);
   remap(m_OscillationState);
+  // The contact memory follows the parents too (a new vertex of a held
+  // edge is held as its parent).
+  if (!m_ContactFactors.empty())
+  {
+    remap(m_ContactFactors);
+    m_HeldPoints.clear();
+    for (SizeValueType i = 0; i < newNumberOfPoints; ++i)
+    {
+      if (m_ContactFactors[i] < 1.0f)
+      {
+        m_HeldPoints.push_back(static_cast<IndexType32>(i));
+      }
+    }
+  }
   remap(m_DisplacementMagnitudes);
   remap(m_ExternalForceMagnitudes);
   remap(m_InternalForceMagnitudes);
@@ -2093,6 +2208,7 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
      << " (first end " << m_FirstContourEnd << ")" << std::endl;
   os << indent << "PreventSelfIntersections: " << (m_PreventSelfIntersections ? "On" : "Off") << std::endl;
   os << indent << "MinimumDistance: " << m_MinimumDistance << std::endl;
+  os << indent << "RememberContacts: " << (m_RememberContacts ? "On" : "Off") << std::endl;
   os << indent << "NumberOfCollisionsPrevented: " << m_NumberOfCollisionsPrevented << " (total "
      << m_TotalNumberOfCollisionsPrevented << "), constrained vertices: " << m_NumberOfConstrainedVertices
      << ", collision index rebuilds: " << m_Collision.GetNumberOfRebuilds() << std::endl;

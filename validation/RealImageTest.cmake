@@ -1,7 +1,7 @@
 # Segments a real scan with edmodel's defaults and scores the surface against
 # a reference segmentation (edmScore): fails when edmodel fails, when the
-# Dice or the mean boundary distance misses its limit, or, with EXTRA
-# holding --prevent-self-intersections, when the surface intersects itself.
+# Dice or the mean boundary distance misses its limit, or, unless EXTRA
+# holds --allow-self-intersections, when the surface intersects itself.
 # -DEDMODEL= -DSCORE= -DIMAGE= -DREFERENCE= -DSPHERE=X,Y,Z,R -DOUTPUT= -DMIN_DICE= -DMAX_MEAN= [-DEXTRA=a|b]
 string(REPLACE "|" ";" EXTRA "${EXTRA}")
 file(REMOVE "${OUTPUT}")
@@ -11,10 +11,11 @@ message(STATUS "${err}${out}")
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "edmodel exited with ${rc}")
 endif()
-# --prevent-self-intersections keeps the surface from intersecting itself
-# (ch2bet without it: 70 intersecting pairs of triangles).
-string(FIND "${EXTRA}" "--prevent-self-intersections" prevent)
-if(prevent GREATER -1 AND NOT out MATCHES "surface quality: 0 intersecting pairs of triangles")
+# The collision test (on by default) keeps the surface from intersecting
+# itself (ch2bet without it, --allow-self-intersections: 70 intersecting
+# pairs of triangles).
+string(FIND "${EXTRA}" "--allow-self-intersections" allow)
+if(allow EQUAL -1 AND NOT out MATCHES "surface quality: 0 intersecting pairs of triangles")
   message(FATAL_ERROR "the surface intersects itself, or edmodel gave no quality summary")
 endif()
 execute_process(COMMAND ${SCORE} score ${OUTPUT} ${REFERENCE} --min-dice ${MIN_DICE} --max-mean ${MAX_MEAN}

@@ -1406,7 +1406,7 @@ RunSegmentContour(const SegmentOptions & o, const GlobalOptions & global)
     }
     CheckOutputDirectoryOf(o.overlayPng, "--overlay-png");
   }
-  if (o.preventSelfIntersections)
+  if (o.preventSelfIntersections && o.preventSelfIntersectionsGiven)
   {
     throw Error("--prevent-self-intersections works on the triangles of surfaces, not on 2-D contours");
   }

@@ -367,6 +367,8 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                   o.elasticity = ParseDouble("--elasticity", s);
                   RequireInRange("--elasticity", o.elasticity, 0.0, 1.0);
                 } });
+  const std::string collisionDefault =
+    std::string(defaults::PreventSelfIntersections ? "on" : "off") + " for 3-D surfaces (not used on 2-D contours)";
   t.push_back({ model,
                 "--prevent-self-intersections",
                 "",
@@ -374,12 +376,26 @@ MakeSegmentOptions(SegmentOptions & o, GlobalOptions & global)
                 "--minimum-distance: the displacements of the vertices of colliding triangles are halved, then "
                 "zeroed; an --init-mesh that intersects itself is an error (3-D surfaces only; slower, much slower "
                 "where the surface is pressed against itself over a wide area)",
-                defaults::PreventSelfIntersections ? "on" : "off",
-                [&o](const std::string &) { o.preventSelfIntersections = true; } });
+                collisionDefault,
+                [&o](const std::string &) {
+                  o.preventSelfIntersections = true;
+                  o.preventSelfIntersectionsGiven = true;
+                } });
+  t.push_back({ model,
+                "--allow-self-intersections",
+                "",
+                "turn the collision test of --prevent-self-intersections off: faster (about a third of the time on "
+                "a brain), but parts of the surface may pass through each other where they meet",
+                "the test is " + collisionDefault,
+                [&o](const std::string &) {
+                  o.preventSelfIntersections = false;
+                  o.preventSelfIntersectionsGiven = true;
+                } });
   t.push_back({ model,
                 "--minimum-distance",
                 "MM",
-                "with --prevent-self-intersections, the smallest distance a step may leave between two triangles "
+                "with the collision test (--prevent-self-intersections), the smallest distance a step may leave "
+                "between two triangles "
                 "sharing no vertex, physical units (mm); 0 only keeps them from intersecting; keep it below half "
                 "the shortest edge",
                 FormatNumber(defaults::MinimumDistanceOverEdgeLength) + " x --edge-length",

@@ -80,23 +80,21 @@ constexpr double       ConvergenceTolerance = 0.02;
 /** A level is quiet when at most this fraction of its vertices move by the
  * tolerance or more (the filter's ConvergenceFraction). */
 constexpr double ConvergenceFraction = 0.005;
-/** --prevent-self-intersections (the filter's PreventSelfIntersections) is
- * off by default: it keeps the surface from intersecting itself, but where
- * a wide contact holds thousands of points at every iteration it is slow.
- * On ch2bet from the validation's sphere (2026-12-05) it costs 6 to 7 s
- * against 1.5 to 2 s, but with --sigma 2 144 s (260 s before the halving
- * loop ran in parallel) and with --region 0.125 65 s (the 65 538-point
- * level pressed into the interhemispheric fissure: 1 500 to 2 800 points
- * held at every iteration, docs/performance.md). With it, no
- * step leaves two triangles sharing no vertex closer than
- * MinimumDistanceOverEdgeLength times --edge-length (0.05 mm on a 1 mm
- * grid): without the test ch2bet ends with 70 intersecting pairs of
- * triangles (smallest angle 2.21 degrees); with it and a distance of 0 with
- * none, but with the fronts pressed onto each other (smallest angle 0.13
- * degrees, 24 triangles under 1 degree); with 0.05 with none and 2.57
- * degrees (0.1: 3.57 degrees, a third slower). Dice and mean distance the
- * same to 4 digits in all four. */
-constexpr bool   PreventSelfIntersections = false;
+/** The collision test (the filter's PreventSelfIntersections) is on by
+ * default for 3-D surfaces (--allow-self-intersections turns it off): no
+ * step leaves two triangles sharing no vertex intersecting or closer than
+ * MinimumDistanceOverEdgeLength times --edge-length (0.05 mm on a 1 mm grid).
+ * Without it, 16 of the 26 runs of bench/robustness.sh end with a surface
+ * that intersects itself (ch2bet with the defaults: 70 pairs of triangles;
+ * with --sigma 2: 5 879), with it none does, with the same Dice to 0.001
+ * (2026-12-07). It costs time: on ch2bet from the validation's sphere about
+ * 6 s against 2 s, and where a wide contact holds thousands of points at
+ * every iteration (ch2bet with --sigma 2) about a minute (docs/performance.md).
+ * With a distance of 0 the fronts that meet in the interhemispheric fissure
+ * are pressed onto each other (smallest angle 0.13 degrees, 24 triangles
+ * under 1 degree); 0.05 keeps them open (2.57 degrees; 0.1: 3.57 degrees, a
+ * third slower), the Dice and mean distance the same to 4 digits. */
+constexpr bool   PreventSelfIntersections = true;
 constexpr double MinimumDistanceOverEdgeLength = 0.05;
 /** Subdivisions of the octahedron of --init-sphere (4 * 4^n + 2 points). */
 constexpr unsigned int SphereResolution = 4;
@@ -230,6 +228,7 @@ struct SegmentOptions
   double balloon{ GetCoreDefaults().Balloon };
   double regionWeight{ -1.0 }; // negative: defaults::RegionWeightInVoxels times the smallest spacing
   bool   preventSelfIntersections{ defaults::PreventSelfIntersections };
+  bool   preventSelfIntersectionsGiven{ false }; // 2-D contours: only an explicit --prevent-self-intersections
   double minimumDistance{ -1.0 };    // negative: defaults::MinimumDistanceOverEdgeLength times the edge length
   double edgeSearchWeight{ -1.0 };   // negative: defaults::EdgeSearchWeightInVoxels times the smallest spacing
   double edgeSearchDistance{ -1.0 }; // non-positive: defaults::EdgeSearchDistanceInVoxels times the smallest spacing

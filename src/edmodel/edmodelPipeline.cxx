@@ -504,8 +504,9 @@ RunSegment(const SegmentOptions & o, const GlobalOptions & global)
       if (intersections > 0)
       {
         throw Error("--init-mesh: mesh '" + o.initMesh + "' intersects itself (" + std::to_string(intersections) +
-                    " pairs of triangles sharing no vertex intersect), and --prevent-self-intersections needs "
-                    "a surface that does not; repair it, or leave that option out");
+                    " pairs of triangles sharing no vertex intersect), and the collision test "
+                    "(--prevent-self-intersections, on by default) needs a surface that does not; repair it, or pass "
+                    "--allow-self-intersections");
       }
     }
   }

@@ -265,7 +265,7 @@ TEST(ParameterDefaults, AgreeInTheITKAndVTKClassesThePluginAndTheCommandLine)
                 static_cast<double>(itkModel->GetPreventSelfIntersections()),
                 static_cast<double>(vtkModel->GetPreventSelfIntersections()),
                 "--prevent-self-intersections",
-                "off" },
+                "on for 3-D surfaces (not used on 2-D contours)" },
     { "MinimumDistance",
                 itkModel->GetMinimumDistance(),
                 vtkModel->GetMinimumDistance(),
