@@ -3,7 +3,9 @@
 # (brain extraction) and ch2bet (outline), with the defaults and with each
 # main parameter halved and doubled; prints Dice and mean boundary distance
 # (mm) against ch2bet's brain voxels (validation/edmScore).
-# Usage: bench/robustness.sh [BUILD_DIR]   (default: build; about 2.5 min)
+# Usage: bench/robustness.sh [BUILD_DIR]   (default: build; about 5 min with the
+# collision test, on by default since 2026-12-07: ch2bet with --sigma 2 alone
+# takes a minute)
 set -eu
 build=${1:-build}
 templates=/usr/share/mricron/templates
