@@ -124,6 +124,15 @@ if [ "$wrap_python" = ON ] && [ -f "$src/Wrapping/Generators/Python/module_ext.i
   grep -q SWIGPY_SLICEOBJECT "$src/Wrapping/Generators/Python/module_ext.i.in" || {
     echo "build-itk: could not define SWIGPY_SLICEOBJECT in ITK's module_ext.i.in" >&2; exit 2; }
 fi
+types_py="$src/Wrapping/Generators/Python/itk/support/types.py"
+if [ "$wrap_python" = ON ] && [ -f "$types_py" ] && grep -q 'np\.bool)' "$types_py"; then
+  # ITK 5.2's Python package names NumPy's boolean type np.bool, an alias
+  # NumPy 1.24 (Debian 12's) removed: `import itk` fails with "module 'numpy'
+  # has no attribute 'bool'". np.bool_ is the type it meant (ITK 5.3 and
+  # later use it). Wrapping only.
+  sed -i 's/np\.bool)/np.bool_)/' "$types_py"
+  ! grep -q 'np\.bool)' "$types_py" || { echo "build-itk: could not patch $types_py" >&2; exit 2; }
+fi
 grg="$src/Modules/Filtering/ImageGradient/wrapping/itkGradientRecursiveGaussianImageFilter.wrap"
 if [ "$wrap_python" = ON ] && [ -f "$grg" ] && grep -q 'ITKM_I${cv}2${image_dim}' "$grg"; then
   # ITK's wrapping of GradientRecursiveGaussianImageFilter for scalar images
