@@ -86,9 +86,10 @@ constexpr double ConvergenceFraction = 0.005;
  * MinimumDistanceOverEdgeLength times --edge-length (0.05 mm on a 1 mm grid).
  * Without it, 16 of the 26 runs of bench/robustness.sh end with a surface
  * that intersects itself (ch2bet with the defaults: 70 pairs of triangles;
- * with --sigma 2: 5 879), with it none does, with the same Dice to 0.001
- * (2026-12-07). It costs time: on ch2bet from the validation's sphere about
- * 6 s against 2 s, and where a wide contact holds thousands of points at
+ * with --sigma 2: 5 879); with it none does, and every Dice is within
+ * 0.008 of the defaults' (2026-12-07; without it, 2026-12-05: within 0.014).
+ * It costs time: on ch2bet from the validation's sphere 7 to 8 s against
+ * 2.7 to 2.9 s, and where a wide contact holds thousands of points at
  * every iteration (ch2bet with --sigma 2) about a minute (docs/performance.md).
  * With a distance of 0 the fronts that meet in the interhemispheric fissure
  * are pressed onto each other (smallest angle 0.13 degrees, 24 triangles
