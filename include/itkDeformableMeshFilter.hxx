@@ -1116,8 +1116,15 @@ DeformableMeshFilter<TMesh, TForceImage>::ConstrainSelfIntersections(std::vector
       q = start[3 * i + c] + f * (q - start[3 * i + c]);
     }
   }
-  const auto result = m_Collision.Constrain(
-    start.data(), m_NextCoordinates.data(), m_MinimumDistance, this->GetMultiThreader(), this->GetNumberOfWorkUnits());
+  // blockMaximum: the step's largest displacement per block (the held
+  // proposals, scaled down, are within it).
+  const auto result =
+    m_Collision.Constrain(start.data(),
+                          m_NextCoordinates.data(),
+                          m_MinimumDistance,
+                          this->GetMultiThreader(),
+                          this->GetNumberOfWorkUnits(),
+                          blockMaximum.empty() ? -1.0 : *std::max_element(blockMaximum.begin(), blockMaximum.end()));
   m_NumberOfCollisionsPrevented = result.violations;
   m_TotalNumberOfCollisionsPrevented += result.violations;
   m_NumberOfConstrainedVertices = result.constrained;

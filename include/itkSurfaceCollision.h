@@ -1808,9 +1808,18 @@ public:
    * pair of triangles sharing no vertex violates the constraint described
    * in the class documentation, given the current positions \a x, clear.
    * \a minimumDistance is in the units of the coordinates, >= 0.
-   * \a threader (may be null) runs the passes over \a workUnits units. */
+   * \a threader (may be null) runs the passes over \a workUnits units.
+   * \a largestStep: the largest distance between a point of \a x and its
+   * proposal in \a y, or a bound of it, when the caller knows it (a
+   * deformable model's step does); it tells the certificate when a surface
+   * has slowed down (CarryNow()). Negative: unknown. */
   Result
-  Constrain(const double * x, double * y, double minimumDistance, MultiThreaderBase * threader, unsigned int workUnits)
+  Constrain(const double *      x,
+            double *            y,
+            double              minimumDistance,
+            MultiThreaderBase * threader,
+            unsigned int        workUnits,
+            double              largestStep = -1.0)
   {
     Result              result;
     const SizeValueType n = m_NumberOfPoints;
@@ -1832,7 +1841,7 @@ public:
       m_IndexValid = false;
     }
     const SurfaceCollisionDetail::ParallelBlocks parallel{ threader, workUnits };
-    if (this->Certify(y, minimumDistance, parallel))
+    if (this->Certify(y, minimumDistance, parallel, largestStep))
     {
       m_NumberOfDeferredTriangles = 0;
       return result;
@@ -3017,10 +3026,12 @@ private:
 
   /** Constrain()'s and FindContacts()'s use of the certificate: true when
    * the positions \a y are accepted without the index (which is then
-   * dropped); after a failure the next tries wait 1, 2, 4, ... 64 calls. */
+   * dropped); after a failure the next tries wait 1, 2, 4, ... 64 calls.
+   * \a largestStep: Constrain()'s, for CarryNow(); negative when unknown
+   * (FindContacts()). */
   template <typename TParallel>
   bool
-  Certify(const double * y, double minimumDistance, TParallel && parallel)
+  Certify(const double * y, double minimumDistance, TParallel && parallel, double largestStep = -1.0)
   {
     if (!m_UseStarCertificate || !m_Closed || minimumDistance != 0.0)
     {
@@ -3034,6 +3045,13 @@ private:
       ++m_CarryYield;
       m_IndexValid = false;
       return true;
+    }
+    if (m_CarriedMargin > 0.0 && m_CarryYield < 2 && largestStep >= 0.0)
+    {
+      // A carry that ended too soon: the step that ended it, against which
+      // CarryNow() measures the later steps.
+      m_FailedCarryStep = largestStep;
+      m_ShortSteps = 0;
     }
     m_CarriedMargin = 0.0;
     if (m_CertificateWait > 0)
@@ -3049,7 +3067,7 @@ private:
       ++m_NumberOfCertifiedSteps;
       ++m_TotalNumberOfCertifiedSteps;
       m_IndexValid = false;
-      if (!pure.undecided && this->CarryNow())
+      if (!pure.undecided && this->CarryNow(largestStep))
       {
         this->CarryCertificate(y, pure, parallel);
       }
@@ -3065,10 +3083,18 @@ private:
    * products each, and a copy of the points): it pays when at least two
    * steps are carried. After a carried margin that certified fewer, the
    * next tries wait 1, 2, 4, ... 64 certificates (a surface remeshed every
-   * few steps, whose margins do not last); after one that certified two or
-   * more, none. */
+   * few steps, whose margins do not last, or one that moves by more than
+   * its margins at each step); after one that certified two or more, none.
+   * While they wait, the steps are measured when the caller of Constrain()
+   * gives their length (\a largestStep >= 0): two certified steps in a row
+   * 8 times shorter than the one that ended the last carry end the wait,
+   * once for that carry (a surface that travelled and has slowed down on
+   * the object: on the benchmark's sphere of a million points, steps of
+   * 0.4 to 0.48 mm against margins of 0.0002 to 0.013 mm while it
+   * travelled, then 0.002 to 0.02 mm, and the wait of 64 certificates it
+   * had reached kept three updates of 20 steps from carrying). */
   bool
-  CarryNow()
+  CarryNow(double largestStep)
   {
     if (m_CarryTried)
     {
@@ -3076,6 +3102,17 @@ private:
         m_CarryYield >= 2 ? 0 : std::min<unsigned int>(64, std::max<unsigned int>(1, 2 * m_CarryBackoff));
       m_CarryWait = m_CarryBackoff;
       m_CarryTried = false;
+    }
+    if (m_CarryWait > 0 && m_FailedCarryStep > 0.0 && largestStep >= 0.0)
+    {
+      m_ShortSteps = 8.0 * largestStep <= m_FailedCarryStep ? m_ShortSteps + 1 : 0;
+      if (m_ShortSteps >= 2)
+      {
+        m_CarryWait = 0;
+        m_CarryBackoff = 0;
+        m_FailedCarryStep = 0.0;
+        m_ShortSteps = 0;
+      }
     }
     if (m_CarryWait > 0)
     {
@@ -5063,6 +5100,12 @@ private:
   bool          m_CarryTried{ false };
   unsigned int  m_CarryWait{ 0 };
   unsigned int  m_CarryBackoff{ 0 };
+
+  // CarryNow(): the step that ended the last carry too soon (0: none, or
+  // its wait already ended), and the certified steps since, in a row, 8
+  // times shorter.
+  double       m_FailedCarryStep{ 0.0 };
+  unsigned int m_ShortSteps{ 0 };
 
   // The index (see the class documentation).
   bool                            m_IndexValid{ false };

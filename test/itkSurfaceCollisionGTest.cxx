@@ -1174,6 +1174,84 @@ TEST(SurfaceCollision, TheCertificateCarriesToPositionsWithinItsMargin)
   EXPECT_EQ(computed, "YNYNNYNNNNYN");
 }
 
+TEST(SurfaceCollision, ASurfaceThatSlowsDownIsCarriedAgain)
+{
+  // A sphere that grows and shrinks by 5 carried margins at alternate steps
+  // for 40 steps (every carried margin ends at the next step: the carries
+  // wait 1, 2, 4, ... 64 certificates), then grows by a hundredth of a
+  // margin a step. Told the
+  // steps' lengths, the certificate ends the wait after two short steps and
+  // carries the following ones; not told, it is still waiting 12 steps
+  // later. Every step is certified either way.
+  std::vector<double>   x0;
+  std::vector<uint32_t> triangles;
+  StarSphere(x0, triangles);
+  const std::size_t n = x0.size() / 3;
+  double            centre[3] = { 0.0, 0.0, 0.0 };
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    for (unsigned int d = 0; d < 3; ++d)
+    {
+      centre[d] += x0[3 * i + d] / static_cast<double>(n);
+    }
+  }
+  double margin = 0.0;
+  {
+    itk::SurfaceCollision probe;
+    probe.SetSurface(n, triangles.data(), triangles.size() / 3);
+    std::vector<double> y = x0;
+    probe.Constrain(x0.data(), y.data(), 0.0, nullptr, 1);
+    margin = probe.GetCarriedMargin();
+  }
+  ASSERT_GT(margin, 0.0);
+  const auto run = [&](bool giveSteps, itk::SizeValueType & certified) {
+    itk::SurfaceCollision collision;
+    collision.SetSurface(n, triangles.data(), triangles.size() / 3);
+    std::vector<double> x = x0;
+    itk::SizeValueType  carriedAtRest = 0;
+    for (int step = 0; step < 52; ++step)
+    {
+      // Radially from the centre by `length` at every point.
+      const double        length = step < 40 ? 5.0 * margin : 0.01 * margin;
+      const double        sign = step < 40 && step % 2 == 1 ? -1.0 : 1.0;
+      std::vector<double> y = x;
+      for (std::size_t i = 0; i < n; ++i)
+      {
+        double r[3];
+        double norm = 0.0;
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          r[d] = x[3 * i + d] - centre[d];
+          norm += r[d] * r[d];
+        }
+        norm = std::sqrt(norm);
+        for (unsigned int d = 0; d < 3; ++d)
+        {
+          y[3 * i + d] += sign * length * r[d] / norm;
+        }
+      }
+      const itk::SizeValueType carried = collision.GetTotalNumberOfCarriedCertificates();
+      EXPECT_EQ(collision.Constrain(x.data(), y.data(), 0.0, nullptr, 1, giveSteps ? length : -1.0).constrained, 0u);
+      if (step >= 40)
+      {
+        carriedAtRest += collision.GetTotalNumberOfCarriedCertificates() - carried;
+      }
+      if (step == 39)
+      {
+        EXPECT_EQ(collision.GetTotalNumberOfCarriedCertificates(), 0u) << "no margin lasts a step of 5 margins";
+      }
+      x = y;
+    }
+    certified = collision.GetTotalNumberOfCertifiedSteps();
+    return carriedAtRest;
+  };
+  itk::SizeValueType certified = 0;
+  EXPECT_EQ(run(true, certified), 10u) << "the wait ends after two short steps";
+  EXPECT_EQ(certified, 52u);
+  EXPECT_EQ(run(false, certified), 0u) << "without the steps' lengths, the wait of 64 certificates goes on";
+  EXPECT_EQ(certified, 52u);
+}
+
 TEST(SurfaceCollision, TheCertificateFollowsTheTrianglesOfPointsBeyondItsMargin)
 {
   // From a carried certificate, steps that move up to 8 of the 258 points
