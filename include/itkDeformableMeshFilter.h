@@ -1075,6 +1075,10 @@ private:
   // table indexed by their rank in m_GeneralVertices (sorted).
   std::vector<IndexType32> m_NeighbourOffsets;
   std::vector<IndexType32> m_Neighbours;
+  // BuildTopologyFromRemesher()'s output, swapped with m_Neighbours: the
+  // input's rings are read while the output's are written (kept so that
+  // their pages are not faulted in at every remeshing).
+  std::vector<IndexType32> m_SpareNeighbours;
   std::vector<uint8_t>     m_RingKinds;
   bool                     m_ClosedFans{ false }; // every ring a closed fan (FindBoundaryVertices())
   std::vector<IndexType32> m_GeneralVertices;

@@ -321,6 +321,22 @@ public:
     return m_Parents;
   }
 
+  /** The number in the last Remesh()'s output of point \a p of its input,
+   * Invalid when the remeshing removed it. The input's points that stay
+   * keep their order (the output numbers them in the order of the input,
+   * each followed by the points split from its edges). Invalid for every
+   * point once RenumberOutput() has renumbered the output, or when no
+   * Remesh() ran. */
+  IndexType
+  OutputOfInput(IndexType p) const
+  {
+    if (p >= m_InputPoints || m_InputMap == InputMapNone)
+    {
+      return Invalid;
+    }
+    return m_InputMap == InputMapIdentity ? p : m_NewIndex[p];
+  }
+
   /** Renumbers the points of the last Remesh()'s output: \a order[k] is
    * the point that takes number k (a permutation of the output's points).
    * \a triangles, the output's triangles as Remesh() returned them, are
@@ -710,6 +726,17 @@ private:
   Statistics             m_Statistics;
   double                 m_Min2{ 0.0 };
   double                 m_Max2{ 0.0 };
+
+  // What OutputOfInput() reads: nothing, the identity (Compact() kept the
+  // numbering), or m_NewIndex as Compact() left it.
+  enum : uint8_t
+  {
+    InputMapNone,
+    InputMapIdentity,
+    InputMapNewIndex
+  };
+  uint8_t m_InputMap{ InputMapNone };
+
   // The queue of the next RunQueue() (a bit per corner), its workers: the
   // whole mesh's, and the parts'.
   std::vector<uint64_t>    m_Queue;
@@ -2358,6 +2385,7 @@ DeformableMeshRemesher::Compact(std::vector<double> &    coordinates,
   {
     // No point added or removed: the numbering and the triangles' order stay
     // (flips changed some corners).
+    m_InputMap = InputMapIdentity;
     coordinates.assign(m_X.begin(), m_X.end());
     if (m_Statistics.flips > 0 || !trianglesHoldInput)
     {
@@ -2458,6 +2486,7 @@ DeformableMeshRemesher::Compact(std::vector<double> &    coordinates,
     m_State.swap(state);
     m_Touched.swap(touched);
     m_Valence.swap(valence);
+    m_InputMap = InputMapNewIndex;
 
     // A table that does not describe the output is built again next time.
     m_TableValid = this->ReorderTable(newIndex, kept, triangles);
@@ -2651,6 +2680,7 @@ DeformableMeshRemesher::RenumberOutput(const std::vector<IndexType> & order, std
     itkGenericExceptionMacro("DeformableMeshRemesher: RenumberOutput() needs the triangles of the last Remesh()'s "
                              "output.");
   }
+  m_InputMap = InputMapNone; // m_NewIndex becomes the rank
   std::vector<IndexType> & rank = m_NewIndex;
   rank.assign(numberOfPoints, Invalid);
   for (std::size_t k = 0; k < numberOfPoints; ++k)
@@ -2753,51 +2783,11 @@ DeformableMeshRemesher::Remesh(const std::vector<double> &    inputCoordinates,
                                                         << inputCoordinates.size() << " coordinates for "
                                                         << numberOfPoints << " points.");
   }
-  // In parallel (a serial pass over the corners costs about as much as a
-  // remeshing's operations on a large mesh at rest); the first bad point for
-  // the message.
-  std::atomic<bool> outOfRange{ false };
-  this->ParallelFor(
-    triangles.size(),
-    [&](std::size_t first, std::size_t last) {
-      IndexType largest = 0;
-      for (std::size_t c = first; c < last; ++c)
-      {
-        largest = std::max(largest, triangles[c]);
-      }
-      if (last > first && largest >= numberOfPoints)
-      {
-        outOfRange = true;
-      }
-    },
-    65536);
-  if (outOfRange)
-  {
-    for (const IndexType v : triangles)
-    {
-      if (v >= numberOfPoints)
-      {
-        itkGenericExceptionMacro("DeformableMeshRemesher: a triangle refers to point " << v << " of " << numberOfPoints
-                                                                                       << ".");
-      }
-    }
-  }
-  m_Statistics = Statistics{};
-  m_ShortEdgesValid = false;
-  m_StillShortValid = false;
-  m_InputPoints = numberOfPoints;
-  m_PartOfParts = 0;
-  m_Min2 = GetMinimumEdgeLength() * GetMinimumEdgeLength();
-  m_Max2 = GetMaximumEdgeLength() * GetMaximumEdgeLength();
-  m_X.assign(inputCoordinates.begin(), inputCoordinates.begin() + 3 * numberOfPoints);
-  m_Parents.resize(numberOfPoints);
-  std::iota(m_Parents.begin(), m_Parents.end(), IndexType{ 0 });
   // The table of the last output describes this input when it is given
-  // again: no need to build it.
+  // again: no need to build it, nor to check the triangles' point numbers
+  // (the table's are those of its points).
   // Locked vertices are frozen in a table of their own, which is not kept.
-  std::vector<uint8_t> locked;
-  locked.swap(m_Locked);
-  const bool lock = std::find(locked.begin(), locked.end(), uint8_t{ 1 }) != locked.end();
+  const bool lock = std::find(m_Locked.begin(), m_Locked.end(), uint8_t{ 1 }) != m_Locked.end();
   bool       reuse = !lock && m_TableValid && m_State.size() == numberOfPoints && m_V.size() == triangles.size();
   if (reuse)
   {
@@ -2813,6 +2803,51 @@ DeformableMeshRemesher::Remesh(const std::vector<double> &    inputCoordinates,
       65536);
     reuse = !differs;
   }
+  if (!reuse)
+  {
+    // In parallel (a serial pass over the corners costs about as much as a
+    // remeshing's operations on a large mesh at rest); the first bad point for
+    // the message.
+    std::atomic<bool> outOfRange{ false };
+    this->ParallelFor(
+      triangles.size(),
+      [&](std::size_t first, std::size_t last) {
+        IndexType largest = 0;
+        for (std::size_t c = first; c < last; ++c)
+        {
+          largest = std::max(largest, triangles[c]);
+        }
+        if (last > first && largest >= numberOfPoints)
+        {
+          outOfRange = true;
+        }
+      },
+      65536);
+    if (outOfRange)
+    {
+      for (const IndexType v : triangles)
+      {
+        if (v >= numberOfPoints)
+        {
+          itkGenericExceptionMacro("DeformableMeshRemesher: a triangle refers to point " << v << " of "
+                                                                                         << numberOfPoints << ".");
+        }
+      }
+    }
+  }
+  m_Statistics = Statistics{};
+  m_ShortEdgesValid = false;
+  m_StillShortValid = false;
+  m_InputMap = InputMapNone;
+  m_InputPoints = numberOfPoints;
+  m_PartOfParts = 0;
+  m_Min2 = GetMinimumEdgeLength() * GetMinimumEdgeLength();
+  m_Max2 = GetMaximumEdgeLength() * GetMaximumEdgeLength();
+  m_X.assign(inputCoordinates.begin(), inputCoordinates.begin() + 3 * numberOfPoints);
+  m_Parents.resize(numberOfPoints);
+  std::iota(m_Parents.begin(), m_Parents.end(), IndexType{ 0 });
+  std::vector<uint8_t> locked;
+  locked.swap(m_Locked);
   m_TableValid = false;
   if (!reuse)
   {

@@ -581,6 +581,103 @@ TEST(DeformableMeshRemesher, RenumberedOutputKeepsItsTable)
   }
 }
 
+TEST(DeformableMeshRemesher, OutputOfInputNumbersTheKeptPointsInOrder)
+{
+  // A sphere of edges about 1.9 remeshed to 1.5, then stretched and
+  // remeshed again from the kept table: points split and collapsed each
+  // round. OutputOfInput() gives each input point that stays its output
+  // number, in the input's order, and no number to the others: as many as
+  // the input's points less the collapses, each the parent of its output
+  // point. After RenumberOutput(), no point has one.
+  PointType centre;
+  centre.Fill(0.0);
+  FlatMesh                    mesh = ToFlat(itk::MakeSphereMesh<MeshType>(centre, 10.0, 3));
+  itk::DeformableMeshRemesher remesher;
+  remesher.SetTargetEdgeLength(1.5);
+  constexpr IndexType invalid = std::numeric_limits<IndexType>::max();
+  EXPECT_EQ(remesher.OutputOfInput(0), invalid);
+  for (int round = 0; round < 4; ++round)
+  {
+    const FlatMesh                                input = mesh;
+    const std::size_t                             inputPoints = mesh.Points();
+    const itk::DeformableMeshRemesher::Statistics statistics = remesher.Remesh(mesh.x, inputPoints, mesh.triangles);
+    std::size_t                                   kept = 0;
+    IndexType                                     last = 0;
+    for (std::size_t p = 0; p < inputPoints; ++p)
+    {
+      const IndexType k = remesher.OutputOfInput(static_cast<IndexType>(p));
+      if (k == invalid)
+      {
+        continue;
+      }
+      ASSERT_LT(k, mesh.Points()) << "round " << round << ", point " << p;
+      EXPECT_EQ(remesher.Parents()[k], p) << "round " << round << ", point " << p;
+      if (kept > 0)
+      {
+        ASSERT_GT(k, last) << "round " << round << ", point " << p;
+      }
+      last = k;
+      ++kept;
+    }
+    EXPECT_GT(statistics.splits, 0u) << "round " << round;
+    EXPECT_GT(statistics.collapses, 0u) << "round " << round;
+    EXPECT_GT(kept, 0u) << "round " << round;
+    EXPECT_LT(kept, inputPoints) << "round " << round;
+    // Each output point is an input point's (its parent's number is its
+    // own) or a split point; an output triangle whose points no operation
+    // changed is an input triangle, renumbered.
+    std::size_t splitPoints = 0;
+    for (std::size_t v = 0; v < mesh.Points(); ++v)
+    {
+      splitPoints += remesher.OutputOfInput(remesher.Parents()[v]) != v ? 1 : 0;
+    }
+    EXPECT_EQ(kept + splitPoints, mesh.Points()) << "round " << round;
+    std::set<std::array<IndexType, 3>> output;
+    for (std::size_t t = 0; t < mesh.triangles.size() / 3; ++t)
+    {
+      std::array<IndexType, 3> v{ { mesh.triangles[3 * t], mesh.triangles[3 * t + 1], mesh.triangles[3 * t + 2] } };
+      std::sort(v.begin(), v.end());
+      output.insert(v);
+    }
+    std::size_t unchanged = 0;
+    for (std::size_t t = 0; t < input.triangles.size() / 3; ++t)
+    {
+      std::array<IndexType, 3> v;
+      for (unsigned int j = 0; j < 3; ++j)
+      {
+        v[j] = remesher.OutputOfInput(input.triangles[3 * t + j]);
+      }
+      if (v[0] == invalid || v[1] == invalid || v[2] == invalid || remesher.OutputPointChanged(v[0]) ||
+          remesher.OutputPointChanged(v[1]) || remesher.OutputPointChanged(v[2]))
+      {
+        continue;
+      }
+      std::sort(v.begin(), v.end());
+      EXPECT_EQ(output.count(v), 1u) << "round " << round << ", input triangle " << t;
+      ++unchanged;
+    }
+    if (round > 0) // the first splits nearly every edge of the sphere
+    {
+      EXPECT_GT(unchanged, input.triangles.size() / 3 / 20) << "round " << round;
+    }
+    EXPECT_EQ(remesher.OutputOfInput(static_cast<IndexType>(inputPoints)), invalid);
+    for (std::size_t i = 0; i < mesh.Points(); ++i)
+    {
+      mesh.x[3 * i + 2] *= 1.12; // stretched along z: long edges to split
+      mesh.x[3 * i] *= 0.9;      // shortened along x: short ones to collapse
+    }
+  }
+  const std::size_t inputPoints = mesh.Points();
+  remesher.Remesh(mesh.x, inputPoints, mesh.triangles);
+  std::vector<IndexType> order(mesh.Points());
+  std::iota(order.begin(), order.end(), IndexType{ 0 });
+  ASSERT_TRUE(remesher.RenumberOutput(order, mesh.triangles));
+  for (std::size_t p = 0; p < inputPoints; ++p)
+  {
+    ASSERT_EQ(remesher.OutputOfInput(static_cast<IndexType>(p)), invalid) << "point " << p;
+  }
+}
+
 TEST(DeformableMeshRemesher, IncrementalRemeshingMovesNothingFarFromItsOperations)
 {
   // A sphere remeshed 30 rounds, after which a round makes a few operations
@@ -1273,6 +1370,55 @@ TEST(DeformableMeshRemeshing, ContinuationAbortAndResetGiveTheSameMeshAcrossReme
   once->SetNumberOfIterations(0);
   once->Update();
   EXPECT_TRUE(SameMesh(once->GetOutput(), c.sphere)) << "0 iterations: the input";
+}
+
+TEST(DeformableMeshRemeshing, StepAfterARemeshingIsThatOfANewFilterOnItsOutput)
+{
+  // The elongated case without balloon, remeshed at iterations 10 and 20
+  // (the tables of the rings after a remeshing come from the input's where
+  // no operation changed a vertex's triangles, from the remesher's fans
+  // elsewhere): its 26th iteration gives what a new filter gives from its
+  // output after 25 (tables built from the triangles at its reset, in the
+  // same numbering), to the rounding of single precision at these
+  // coordinates (3.8e-6 mm: the forces and the umbrella vectors are
+  // floats). A neighbour missing from a ring, or another one in its place,
+  // moves a vertex by a fraction of the elasticity times an edge (about
+  // 0.1 mm here).
+  const ElongatedCase & c = Elongated();
+  auto                  remeshing = c.MakeFilter(0.8, 25);
+  remeshing->SetBalloon(0.0);
+  remeshing->SetRemeshingInterval(10);
+  remeshing->SetIterateFromZero(false);
+  remeshing->Update();
+  ASSERT_EQ(remeshing->GetNumberOfRemeshings(), 2u);
+  const auto & done = remeshing->GetRemeshingStatistics();
+  EXPECT_GT(done.splits, 0u);
+  EXPECT_GT(done.collapses, 0u);
+  const FlatMesh          start = OutputOf(remeshing);
+  const MeshType::Pointer input = ToMesh(start, { 0.0, 0.0, 0.0 });
+
+  auto fresh = c.MakeFilter(0.0, 1);
+  fresh->SetInput(input);
+  fresh->SetBalloon(0.0);
+  fresh->SetRenumberForLocality(false);
+  fresh->Update();
+  remeshing->SetNumberOfIterations(26);
+  remeshing->Update();
+  ASSERT_EQ(remeshing->GetNumberOfRemeshings(), 2u);
+  const FlatMesh continued = OutputOf(remeshing);
+  const FlatMesh anew = OutputOf(fresh);
+  ASSERT_EQ(continued.triangles, start.triangles);
+  ASSERT_EQ(anew.triangles, start.triangles);
+  ASSERT_EQ(continued.x.size(), anew.x.size());
+  std::size_t moved = 0;
+  double      largest = 0.0;
+  for (std::size_t k = 0; k < continued.x.size(); ++k)
+  {
+    largest = std::max(largest, std::abs(continued.x[k] - anew.x[k]));
+    moved += continued.x[k] != start.x[k] ? 1 : 0;
+  }
+  EXPECT_LE(largest, 1e-5);
+  EXPECT_GT(moved, continued.x.size() / 2);
 }
 
 // RenumberForLocality after remeshing: the elongated case at 0.5-voxel edges
