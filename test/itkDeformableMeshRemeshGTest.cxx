@@ -1379,9 +1379,12 @@ TEST(DeformableMeshRemeshing, StepAfterARemeshingIsThatOfANewFilterOnItsOutput)
   // no operation changed a vertex's triangles, from the remesher's fans
   // elsewhere): its 26th iteration gives what a new filter gives from its
   // output after 25 (tables built from the triangles at its reset, in the
-  // same numbering), to the rounding of single precision at these
-  // coordinates (3.8e-6 mm: the forces and the umbrella vectors are
-  // floats). A neighbour missing from a ring, or another one in its place,
+  // same numbering), within 1e-5 mm: the two differ by one single-precision
+  // rounding at these coordinates (3.8e-6 mm) on a sixth of the coordinates,
+  // with the walked rings as with the reused ones (cause not traced). The
+  // rings used at the 26th iteration are those of the remeshing at 20 (a
+  // ring with one neighbour replaced there fails this test by 0.065 mm).
+  // A neighbour missing from a ring, or another one in its place,
   // moves a vertex by a fraction of the elasticity times an edge (about
   // 0.1 mm here).
   const ElongatedCase & c = Elongated();
