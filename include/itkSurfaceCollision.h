@@ -3061,7 +3061,11 @@ private:
     }
     StarSummary pure;
     pure.undecided = true;
-    if (this->StarShapedUpToFolds(y, parallel, &pure))
+    // When a pure certificate would be carried, the carried margins are
+    // computed in its pass over the triangles (CarryCertificate()).
+    std::vector<double> & least = m_CarryLeast;
+    least.clear();
+    if (this->StarShapedUpToFolds(y, parallel, &pure, this->PlanCarry(largestStep).carry ? &least : nullptr))
     {
       m_CertificateBackoff = 0;
       ++m_NumberOfCertifiedSteps;
@@ -3069,7 +3073,7 @@ private:
       m_IndexValid = false;
       if (!pure.undecided && this->CarryNow(largestStep))
       {
-        this->CarryCertificate(y, pure, parallel);
+        this->CarryCertificate(y, pure, least);
       }
       return true;
     }
@@ -3096,32 +3100,59 @@ private:
   bool
   CarryNow(double largestStep)
   {
-    if (m_CarryTried)
+    const CarryPlan plan = this->PlanCarry(largestStep);
+    m_CarryTried = plan.tried;
+    m_CarryYield = plan.yield;
+    m_CarryWait = plan.wait;
+    m_CarryBackoff = plan.backoff;
+    m_FailedCarryStep = plan.failedStep;
+    m_ShortSteps = plan.shortSteps;
+    return plan.carry;
+  }
+
+  /** CarryNow()'s decision and the state it leaves, without changing this
+   * one (Certify() asks before the certificate whether a carry would
+   * follow it). */
+  struct CarryPlan
+  {
+    bool          carry;
+    bool          tried;
+    SizeValueType yield;
+    unsigned int  wait;
+    unsigned int  backoff;
+    double        failedStep;
+    unsigned int  shortSteps;
+  };
+  CarryPlan
+  PlanCarry(double largestStep) const
+  {
+    CarryPlan plan{ false, m_CarryTried, m_CarryYield, m_CarryWait, m_CarryBackoff, m_FailedCarryStep, m_ShortSteps };
+    if (plan.tried)
     {
-      m_CarryBackoff =
-        m_CarryYield >= 2 ? 0 : std::min<unsigned int>(64, std::max<unsigned int>(1, 2 * m_CarryBackoff));
-      m_CarryWait = m_CarryBackoff;
-      m_CarryTried = false;
+      plan.backoff = plan.yield >= 2 ? 0 : std::min<unsigned int>(64, std::max<unsigned int>(1, 2 * plan.backoff));
+      plan.wait = plan.backoff;
+      plan.tried = false;
     }
-    if (m_CarryWait > 0 && m_FailedCarryStep > 0.0 && largestStep >= 0.0)
+    if (plan.wait > 0 && plan.failedStep > 0.0 && largestStep >= 0.0)
     {
-      m_ShortSteps = 8.0 * largestStep <= m_FailedCarryStep ? m_ShortSteps + 1 : 0;
-      if (m_ShortSteps >= 2)
+      plan.shortSteps = 8.0 * largestStep <= plan.failedStep ? plan.shortSteps + 1 : 0;
+      if (plan.shortSteps >= 2)
       {
-        m_CarryWait = 0;
-        m_CarryBackoff = 0;
-        m_FailedCarryStep = 0.0;
-        m_ShortSteps = 0;
+        plan.wait = 0;
+        plan.backoff = 0;
+        plan.failedStep = 0.0;
+        plan.shortSteps = 0;
       }
     }
-    if (m_CarryWait > 0)
+    if (plan.wait > 0)
     {
-      --m_CarryWait;
-      return false;
+      --plan.wait;
+      return plan;
     }
-    m_CarryTried = true;
-    m_CarryYield = 0;
-    return true;
+    plan.carry = true;
+    plan.tried = true;
+    plan.yield = 0;
+    return plan;
   }
 
   /** What StarShaped() found: the numbers of triangles of each strict
@@ -3190,57 +3221,27 @@ private:
    * surface never passes through o, the degree of the central projection
    * stays 1 and every triangle keeps its orientation, so y is star-shaped
    * from o as x0 is (class documentation). Computed after a certificate
-   * that needed no fold (a pass over the triangles), with a copy of x0.
-   * (A margin per point, the least f of its triangles, carried 57 % of the
+   * that needed no fold, from the least f of each block of triangles that
+   * the certificate's pass found (StarShaped() with \a least), with a copy
+   * of x0. (That pass computes them when Certify() knows that a carry
+   * would follow: a pass of their own, which read the triangles and their
+   * points again, took 14 ms against the certificate's 6 at a million
+   * points, the two together 17 to 18 ms.) (A margin per point, the least f of its triangles, carried 57 % of the
    * combined benchmark's steps at 100k against 53 %, for a pass over the
    * corners more.) */
-  template <typename TParallel>
   void
-  CarryCertificate(const double * x, const StarSummary & summary, TParallel && parallel)
+  CarryCertificate(const double * x, const StarSummary & summary, const std::vector<double> & least)
   {
-    const SizeValueType numberOfTriangles = this->GetNumberOfTriangles();
     m_CarriedMargin = 0.0;
-    if (numberOfTriangles == 0)
+    constexpr SizeValueType block = SurfaceCollisionDetail::ParallelBlocks::Block;
+    const SizeValueType     numberOfTriangles = this->GetNumberOfTriangles();
+    if (numberOfTriangles == 0 || least.size() != (numberOfTriangles + block - 1) / block)
     {
       return;
     }
-    const double            sign = summary.positive > 0 ? 1.0 : -1.0;
-    const double *          o = summary.centre;
-    const double            rounding = summary.sharedBound;
-    constexpr SizeValueType block = SurfaceCollisionDetail::ParallelBlocks::Block;
-    // Per block, the least f = d / (S1 + c S2 + c^2). A triangle is left
-    // without the roots when a bound from below of its f is not below the
-    // block's least so far: (S1 + c S2 + c^2)^2 is at most
-    // 1.11 (S1^2 + 10 c^2 S2^2 + 100 c^4) (Cauchy-Schwarz with the weights
-    // 1, 0.1 and 0.01, near the usual ratios of the three terms).
-    std::vector<double> least((numberOfTriangles + block - 1) / block, 0.0);
-    parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
-      double m = std::numeric_limits<double>::infinity();
-      for (SizeValueType t = begin; t < end; ++t)
-      {
-        double d;
-        double s1Squared;
-        double s2Squared;
-        MarginTerms(x, m_Triangles.data() + 3 * t, o, sign, rounding, d, s1Squared, s2Squared);
-        const double c2 = d * d / s1Squared;
-        if (d > 0.0 && d * d >= m * m * (1.11 * (s1Squared + 10.0 * c2 * s2Squared + 100.0 * c2 * c2)))
-        {
-          continue; // f >= m (false for a NaN: computed below)
-        }
-        const double s1 = std::sqrt(s1Squared);
-        const double s2 = std::sqrt(s2Squared);
-        const double positive = d > 0.0 ? d : 0.0; // NaN: 0
-        const double cap = positive / s1;
-        const double f = positive / (s1 + cap * s2 + cap * cap);
-        m = f < m ? f : m;
-        if (!(f > 0.0))
-        {
-          m = 0.0; // NaN or not positive: nothing carried
-          break;
-        }
-      }
-      least[begin / block] = m;
-    });
+    const double   sign = summary.positive > 0 ? 1.0 : -1.0;
+    const double * o = summary.centre;
+    const double   rounding = summary.sharedBound;
     // Less a millionth: the rounding of S1, S2 and of the quotients.
     const double margin = (1.0 - 1e-6) * *std::min_element(least.begin(), least.end());
     if (!(margin > 0.0 && std::isfinite(margin)))
@@ -3253,6 +3254,43 @@ private:
     m_CarriedSign = sign > 0.0 ? 1 : -1;
     m_CarriedRounding = rounding;
     m_PointLimitsReady = false;
+  }
+
+  /** CarryCertificate()'s bound f of the triangle \a vt at \a x, seen from
+   * \a o, taken into \a m, the least of a block's triangles so far. False
+   * when f is not positive or not a number: \a m is then 0 (nothing is
+   * carried) and the block's other triangles need not be seen. */
+  static bool
+  LowerCarriedMargin(const double * x, const IndexType * vt, const double * o, double sign, double rounding, double & m)
+  {
+    double d;
+    double s1Squared;
+    double s2Squared;
+    MarginTerms(x, vt, o, sign, rounding, d, s1Squared, s2Squared);
+    // The roots are left out when a bound from below of f is not below m:
+    // (S1 + c S2 + c^2)^2 is at most 1.301 (S1^2 + c^2 S2^2 / 0.3 + 1000 c^4)
+    // (Cauchy-Schwarz with the weights 1, 0.3 and 0.001, near the ratios of
+    // the three terms far from the centre: c S2 / S1 was 0.28 to 0.29 and
+    // c^2 / S1 about 1e-4 on the benchmark's sphere of a million points,
+    // where this bound left 5 times fewer triangles to the roots than the
+    // weights 1, 0.1 and 0.01).
+    const double c2 = d * d / s1Squared;
+    if (d > 0.0 && d * d >= m * m * (1.301 * (s1Squared + (1.0 / 0.3) * c2 * s2Squared + 1000.0 * c2 * c2)))
+    {
+      return true; // f >= m (false for a NaN: computed below)
+    }
+    const double s1 = std::sqrt(s1Squared);
+    const double s2 = std::sqrt(s2Squared);
+    const double positive = d > 0.0 ? d : 0.0; // NaN: 0
+    const double cap = positive / s1;
+    const double f = positive / (s1 + cap * s2 + cap * cap);
+    m = f < m ? f : m;
+    if (!(f > 0.0))
+    {
+      m = 0.0; // NaN or not positive: nothing carried
+      return false;
+    }
+    return true;
   }
 
   /** Whether the triangle \a vt keeps its orientation seen from the carried
@@ -3557,10 +3595,15 @@ private:
   }
 
   /** IsStarShaped(), with the passes run by \a parallel; what it found in
-   * \a summary when not null. */
+   * \a summary when not null; in \a carryLeast when not null, the least
+   * carried margin f of each block of triangles (LowerCarriedMargin(), for
+   * CarryCertificate()). */
   template <typename TParallel>
   bool
-  StarShaped(const double * x, TParallel && parallel, StarSummary * summary = nullptr) const
+  StarShaped(const double *        x,
+             TParallel &&          parallel,
+             StarSummary *         summary = nullptr,
+             std::vector<double> * carryLeast = nullptr) const
   {
     const SizeValueType n = m_NumberOfPoints;
     const SizeValueType numberOfTriangles = this->GetNumberOfTriangles();
@@ -3652,8 +3695,17 @@ private:
     // positive triangles, then of negative ones), and whether a sign was
     // zero.
     std::vector<std::array<SizeValueType, 5>> counts(blocks, std::array<SizeValueType, 5>{ { 0, 0, 0, 0, 0 } });
+    // With \a carryLeast, each block's least carried margin f, each
+    // triangle's with its own orientation: when the certificate is pure,
+    // all have the one it is carried with.
+    if (carryLeast != nullptr)
+    {
+      carryLeast->assign(blocks, 0.0);
+    }
     parallel(numberOfTriangles, [&](SizeValueType begin, SizeValueType end) {
       auto & c = counts[begin / block];
+      double least = std::numeric_limits<double>::infinity();
+      bool   margins = carryLeast != nullptr;
       for (SizeValueType t = begin; t < end; ++t)
       {
         const IndexType * vt = m_Triangles.data() + 3 * t;
@@ -3662,6 +3714,10 @@ private:
         {
           ++c[3];
           continue;
+        }
+        if (margins)
+        {
+          margins = LowerCarriedMargin(x, vt, centre, static_cast<double>(orientation), sharedBound, least);
         }
         ++c[orientation > 0 ? 0 : 1];
         if ((sides[vt[0]] & sides[vt[1]] & sides[vt[2]]) != 0)
@@ -3685,6 +3741,10 @@ private:
         {
           ++c[3]; // the ray meets an edge or a point of the triangle
         }
+      }
+      if (carryLeast != nullptr)
+      {
+        (*carryLeast)[begin / block] = least;
       }
     });
     StarSummary found;
@@ -3718,14 +3778,18 @@ private:
    * point fold into each other (SharedVertexGap() 0). Every other direction
    * from the centre is covered by exactly one triangle (positive minus
    * negative coverings is the degree, and no negative triangle covers it),
-   * so no other pair can meet. False when in doubt. */
+   * so no other pair can meet. False when in doubt. \a pure: StarShaped()'s
+   * summary when it succeeded; \a carryLeast: as StarShaped()'s. */
   template <typename TParallel>
   bool
-  StarShapedUpToFolds(const double * x, TParallel && parallel, StarSummary * pure = nullptr) const
+  StarShapedUpToFolds(const double *        x,
+                      TParallel &&          parallel,
+                      StarSummary *         pure = nullptr,
+                      std::vector<double> * carryLeast = nullptr) const
   {
     using SurfaceCollisionDetail::Dot;
     StarSummary summary;
-    if (this->StarShaped(x, parallel, &summary))
+    if (this->StarShaped(x, parallel, &summary, carryLeast))
     {
       if (pure != nullptr)
       {
@@ -5106,6 +5170,9 @@ private:
   // times shorter.
   double       m_FailedCarryStep{ 0.0 };
   unsigned int m_ShortSteps{ 0 };
+
+  // Certify(): the carried margins of the certificate's pass, per block.
+  std::vector<double> m_CarryLeast;
 
   // The index (see the class documentation).
   bool                            m_IndexValid{ false };
