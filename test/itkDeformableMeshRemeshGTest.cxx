@@ -1381,7 +1381,10 @@ TEST(DeformableMeshRemeshing, StepAfterARemeshingIsThatOfANewFilterOnItsOutput)
   // output after 25 (tables built from the triangles at its reset, in the
   // same numbering), within 1e-5 mm: the two differ by one single-precision
   // rounding at these coordinates (3.8e-6 mm) on a sixth of the coordinates,
-  // with the walked rings as with the reused ones (cause not traced). The
+  // with the walked rings as with the reused ones: the output's points are
+  // single precision (itk::Mesh<double, 3> has float coordinates, the
+  // default of DefaultStaticMeshTraits), the continuing filter steps from
+  // its double-precision positions and the new one from their rounding. The
   // rings used at the 26th iteration are those of the remeshing at 20 (a
   // ring with one neighbour replaced there fails this test by 0.065 mm).
   // A neighbour missing from a ring, or another one in its place,
