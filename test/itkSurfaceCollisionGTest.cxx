@@ -986,6 +986,21 @@ CountFoldedFans(const std::vector<double> & x, const std::vector<uint32_t> & tri
   }
   return folded;
 }
+
+/** u x v and u . v in long double, for the certificates' bounds computed
+ * again. */
+void
+LongCross(const long double * u, const long double * v, long double * w)
+{
+  w[0] = u[1] * v[2] - u[2] * v[1];
+  w[1] = u[2] * v[0] - u[0] * v[2];
+  w[2] = u[0] * v[1] - u[1] * v[0];
+}
+long double
+LongDot(const long double * u, const long double * v)
+{
+  return u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+}
 } // namespace
 
 TEST(SurfaceCollision, TheCertificateCarriesToPositionsWithinItsMargin)
@@ -1026,12 +1041,8 @@ TEST(SurfaceCollision, TheCertificateCarriesToPositionsWithinItsMargin)
       r[d] = static_cast<long double>(p[d]) - static_cast<long double>(q[d]);
     }
   };
-  const auto cross = [](const long double * u, const long double * v, long double * w) {
-    w[0] = u[1] * v[2] - u[2] * v[1];
-    w[1] = u[2] * v[0] - u[0] * v[2];
-    w[2] = u[0] * v[1] - u[1] * v[0];
-  };
-  const auto dot = [](const long double * u, const long double * v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; };
+  const auto  cross = LongCross;
+  const auto  dot = LongDot;
   long double nearestPlane = std::numeric_limits<long double>::infinity();
   for (std::size_t t = 0; t < numberOfTriangles; ++t)
   {
@@ -1210,12 +1221,8 @@ TEST(SurfaceCollision, TheCarriedMarginIsTheLeastBoundOfAllTriangles)
       centre[d] += static_cast<long double>(x[3 * i + d]) / static_cast<long double>(n);
     }
   }
-  const auto cross = [](const long double * u, const long double * v, long double * w) {
-    w[0] = u[1] * v[2] - u[2] * v[1];
-    w[1] = u[2] * v[0] - u[0] * v[2];
-    w[2] = u[0] * v[1] - u[1] * v[0];
-  };
-  const auto dot = [](const long double * u, const long double * v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; };
+  const auto  cross = LongCross;
+  const auto  dot = LongDot;
   long double least = std::numeric_limits<long double>::infinity();
   long double largest = 0.0L;
   for (std::size_t t = 0; t < numberOfTriangles; ++t)
