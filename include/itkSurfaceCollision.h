@@ -3224,11 +3224,12 @@ private:
    * that needed no fold, from the least f of each block of triangles that
    * the certificate's pass found (StarShaped() with \a least), with a copy
    * of x0. (That pass computes them when Certify() knows that a carry
-   * would follow: a pass of their own, which read the triangles and their
-   * points again, took 14 ms against the certificate's 6 at a million
-   * points, the two together 17 to 18 ms.) (A margin per point, the least f of its triangles, carried 57 % of the
-   * combined benchmark's steps at 100k against 53 %, for a pass over the
-   * corners more.) */
+   * would follow; a pass of their own, which read the triangles and their
+   * points again, took 12 to 14 ms at a million points against the
+   * certificate's 5 to 7, and the fused pass takes 14 to 16. A margin per
+   * point, the least f of its triangles, carried 57 % of the combined
+   * benchmark's steps at 100k against 53 %, for a pass over the corners
+   * more.) */
   void
   CarryCertificate(const double * x, const StarSummary & summary, const std::vector<double> & least)
   {
