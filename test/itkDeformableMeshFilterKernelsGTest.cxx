@@ -32,11 +32,13 @@
 
 #include <cmath>
 #include <cstring>
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <limits>
 #include <string>
 #include <map>
+#include <random>
 #include <set>
 #include <vector>
 
@@ -793,4 +795,55 @@ TEST(DeformableMeshFilterKernels, SubStepsReportTheWholeIterationsDisplacement)
   }
   EXPECT_DOUBLE_EQ(after->GetLastMaximumDisplacement(), largest);
   EXPECT_GT(largest, 0.1);
+}
+
+// SuppressTangentialDrift's weight skips its square root and division for
+// squares up to DriftWeightless(): there the formula's weight is 0 too, for
+// thresholds of every magnitude and mantissa, at the bound and the 64 squares
+// below it. Above the threshold's own square the weight is the formula's; the
+// bound is below that square.
+TEST(DeformableMeshFilterKernels, TheDriftWeightsShortcutIsTheFormulasZero)
+{
+  namespace Kernel = itk::DeformableMeshFilterDetail::Portable;
+  const auto formula = [](double squared, double threshold) {
+    return std::max(0.0, std::sqrt(squared) / threshold - 1.0);
+  };
+  std::mt19937_64                        random(15);
+  std::uniform_real_distribution<double> mantissa(1.0, 2.0);
+  std::uniform_int_distribution<int>     exponent(-400, 400);
+  unsigned int                           weighted = 0;
+  for (unsigned int k = 0; k < 20000; ++k)
+  {
+    const double threshold = std::ldexp(mantissa(random), exponent(random));
+    const double weightless = Kernel::DriftWeightless(threshold);
+    const double square = threshold * threshold;
+    if (square < std::numeric_limits<double>::min())
+    {
+      EXPECT_EQ(weightless, 0.0) << threshold; // only a zero square skips
+      continue;
+    }
+    if (!std::isfinite(square))
+    {
+      // The threshold above the square root of every double: the formula's
+      // weight is 0 for the largest square.
+      EXPECT_EQ(formula(std::numeric_limits<double>::max(), threshold), 0.0) << threshold;
+      EXPECT_EQ(Kernel::DriftWeight(std::numeric_limits<double>::max(), threshold, weightless), 0.0);
+      continue;
+    }
+    ASSERT_GT(weightless, 0.0) << threshold;
+    ASSERT_LT(weightless, square) << threshold;
+    double squared = weightless;
+    for (unsigned int step = 0; step < 64; ++step)
+    {
+      ASSERT_EQ(formula(squared, threshold), 0.0) << threshold << " " << squared;
+      ASSERT_EQ(Kernel::DriftWeight(squared, threshold, weightless), 0.0);
+      squared = std::nextafter(squared, 0.0);
+    }
+    // Just above the threshold: the formula's small positive weights.
+    squared = square * (1.0 + 1e-9);
+    const double weight = Kernel::DriftWeight(squared, threshold, weightless);
+    ASSERT_EQ(weight, formula(squared, threshold)) << threshold;
+    weighted += weight > 0.0;
+  }
+  EXPECT_GT(weighted, 15000u);
 }
