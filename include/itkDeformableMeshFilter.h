@@ -906,8 +906,14 @@ private:
   static constexpr SizeValueType RenumberingWindow = 2048;
   static constexpr double        RenumberingFarEdgeFraction = 0.1;
   // A remeshed mesh is renumbered once the splits and collapses since the
-  // last renumbering (or the reset) exceed this fraction of its points.
+  // last renumbering (or the reset) exceed this fraction of its points,
   static constexpr double RenumberingOperationFraction = 0.1;
+  // at a remeshing whose own operations are at most this fraction of the
+  // points (a surface still travelling, a third of whose points a remeshing
+  // replaces, would scramble a new numbering at once), or when they exceed
+  // RenumberingOperationLimit times the points.
+  static constexpr double RenumberingCalmFraction = 0.05;
+  static constexpr double RenumberingOperationLimit = 2.0;
 
   void
   PrepareForceSampler();

@@ -1973,7 +1973,8 @@ template <typename TMesh, typename TForceImage>
 void
 DeformableMeshFilter<TMesh, TForceImage>::RenumberRemeshed(std::vector<double> & x)
 {
-  // After many operations, the breadth-first numbering (see the class
+  // After many operations, once a remeshing changes few points (or after
+  // very many operations), the breadth-first numbering (see the class
   // documentation), the remesher's table renumbered with the points, so that
   // what follows (the contact check, the per-vertex state carried from
   // Parents(), the step's tables from the remesher's fans) sees a remeshing
@@ -1981,10 +1982,12 @@ DeformableMeshFilter<TMesh, TForceImage>::RenumberRemeshed(std::vector<double> &
   const RemeshingStatisticsType & last = m_Remesher.GetStatistics();
   m_OperationsSinceRenumbering += last.splits + last.collapses;
   const SizeValueType numberOfPoints = m_Remesher.Parents().size();
+  const auto          operations = static_cast<double>(m_OperationsSinceRenumbering);
+  const auto          points = static_cast<double>(numberOfPoints);
+  const bool          calm = static_cast<double>(last.splits + last.collapses) <= RenumberingCalmFraction * points;
   if (!m_RenumberForLocality || !m_Remesher.GetTopologyChanged() || numberOfPoints <= RenumberingWindow ||
-      x.size() != 3 * numberOfPoints ||
-      static_cast<double>(m_OperationsSinceRenumbering) <=
-        RenumberingOperationFraction * static_cast<double>(numberOfPoints))
+      x.size() != 3 * numberOfPoints || operations <= RenumberingOperationFraction * points ||
+      (!calm && operations <= RenumberingOperationLimit * points))
   {
     return;
   }

@@ -1430,9 +1430,10 @@ TEST(DeformableMeshRemeshing, StepAfterARemeshingIsThatOfANewFilterOnItsOutput)
 // RenumberForLocality after remeshing: the elongated case at 0.5-voxel edges
 // grows from the sphere's 1 026 points to about 17 000, each split point
 // numbered after the point it comes from; past a tenth of the points split
-// or collapsed since the reset, the filter renumbers the remeshed mesh
-// breadth-first. The edges then join points numbered closer together, and
-// the surface is as accurate.
+// or collapsed since the reset, at a remeshing that changes at most a
+// twentieth of them, the filter renumbers the remeshed mesh breadth-first.
+// The edges then join points numbered closer together, and the surface is as
+// accurate.
 TEST(DeformableMeshRemeshing, RenumbersARemeshedSurfaceForLocality)
 {
   const ElongatedCase & c = Elongated();
