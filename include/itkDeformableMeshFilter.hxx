@@ -310,7 +310,7 @@ DeformableMeshFilter<TMesh, TForceImage>::BuildTopology(const std::vector<IndexT
   const SizeValueType numberOfPoints = this->GetNumberOfCachedPoints();
   if (!edgesUnique)
   {
-    std::sort(edges.begin(), edges.end());
+    SortEdgeKeys(edges, numberOfPoints);
     edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
   }
 
@@ -865,7 +865,7 @@ DeformableMeshFilter<TMesh, TForceImage>::FindBoundaryVertices(const std::vector
       inTriangle[a] = 1;
     }
   }
-  std::sort(edges.begin(), edges.end());
+  DeformableMeshFilterDetail::SortEdgeKeys(edges, numberOfPoints);
   for (std::size_t k = 0; k < edges.size();)
   {
     std::size_t end = k + 1;

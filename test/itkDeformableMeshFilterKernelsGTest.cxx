@@ -847,3 +847,44 @@ TEST(DeformableMeshFilterKernels, TheDriftWeightsShortcutIsTheFormulasZero)
   }
   EXPECT_GT(weighted, 15000u);
 }
+
+// The reset's sort of edge keys (a counting sort on the smaller point) gives
+// std::sort's order: keys of a random mesh-like set with repeats, a point
+// with 40 keys (sorted with std::sort in its bucket), an empty set, and keys
+// beyond the points (std::sort itself).
+TEST(DeformableMeshFilterKernels, EdgeKeysSortAsStdSortDoes)
+{
+  using itk::DeformableMeshFilterDetail::SortEdgeKeys;
+  std::mt19937_64                         random(3);
+  constexpr uint64_t                      points = 5000;
+  std::uniform_int_distribution<uint64_t> point(0, points - 1);
+  std::vector<uint64_t>                   keys;
+  for (unsigned int k = 0; k < 30000; ++k)
+  {
+    const uint64_t a = point(random);
+    const uint64_t b = point(random);
+    const uint64_t key = std::min(a, b) << 32 | std::max(a, b);
+    keys.push_back(key);
+    if (k % 2 == 0)
+    {
+      keys.push_back(key); // an edge of two triangles
+    }
+  }
+  for (uint64_t b = 0; b < 40; ++b)
+  {
+    keys.push_back(uint64_t{ 17 } << 32 | (4999 - 3 * b));
+  }
+  std::vector<uint64_t> expected = keys;
+  std::sort(expected.begin(), expected.end());
+  SortEdgeKeys(keys, points);
+  EXPECT_EQ(keys, expected);
+
+  std::vector<uint64_t> none;
+  SortEdgeKeys(none, points);
+  EXPECT_TRUE(none.empty());
+
+  std::vector<uint64_t> beyond = { uint64_t{ 9 } << 32 | 12, uint64_t{ 3 } << 32 | 4, uint64_t{ 7 } << 32 | 8 };
+  SortEdgeKeys(beyond, 8);
+  EXPECT_EQ(beyond,
+            (std::vector<uint64_t>{ uint64_t{ 3 } << 32 | 4, uint64_t{ 7 } << 32 | 8, uint64_t{ 9 } << 32 | 12 }));
+}
