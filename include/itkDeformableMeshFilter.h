@@ -21,6 +21,7 @@
 #include "itkIterativeMeshFilter.h"
 #include "itkImage.h"
 #include "itkDeformableMeshFilterDetail.h"
+#include "itkDeformableMeshFilterEnums.h"
 #include "itkDeformableMeshEdgeSearch.h"
 #include "itkDeformableMeshRegionForce.h"
 #include "itkDeformableMeshRemesher.h"
@@ -149,8 +150,8 @@ namespace itk
  * The balloon's per-vertex release and the diagnostics of a new vertex are
  * those of its parent vertex. Once the surface rests on the object, the
  * force's tangential part keeps its vertices flowing along it, and every
- * remeshing splits and collapses edges where they leave and gather:
- * SuppressTangentialDrift stops that flow.
+ * remeshing splits and collapses edges where they leave and gather: with
+ * remeshing the filter suppresses that flow by default (TangentialDrift).
  *
  * Renumbering: at each reset, an input whose numbering is not local (more
  * than a tenth of its edges join points numbered more than 2048 apart, as in
@@ -282,35 +283,72 @@ public:
   itkGetConstMacro(TangentialElasticity, bool);
   itkBooleanMacro(TangentialElasticity);
 
-  /** When on, the external force's component tangent to the surface is
-   * dropped at the vertices where the surface has come to rest: where the
+  using TangentialDriftEnum = DeformableMeshFilterEnums::TangentialDrift;
+
+  /** What becomes of the external force's component tangent to the surface
+   * where the surface has come to rest. Suppressed, it is dropped where the
    * external displacement (ScaleFactor times the force) is shorter than an
-   * eighth of the mesh's root mean square edge length h, the vertex moves
+   * eighth of the mesh's root mean square edge length h: the vertex moves
    * along its normal only; between h/8 and h/4 the tangential component is
    * blended back in (its weight rises linearly from 0 to 1); beyond h/4 the
-   * force acts whole. Default: off.
+   * force acts whole. Kept, the force acts whole everywhere.
+   * Default: TangentialDriftEnum::SuppressWhenRemeshing, suppressed when the
+   * filter remeshes (RemeshingEdgeLength > 0), kept otherwise.
    *
-   * Why: a force field's tangential component moves vertices along the
-   * surface without changing its shape. Where the surface has converged it
-   * does not vanish (the surface rests where the force's normal part
+   * Why suppress: a force field's tangential component moves vertices along
+   * the surface without changing its shape. Where the surface has converged
+   * it does not vanish (the surface rests where the force's normal part
    * balances the internal forces, off the force field's zero set), so the
    * vertices flow along the surface for ever, toward where the field's
    * tangential part converges; with remeshing this flow is cut into splits
    * and collapses at every remeshing. On the benchmarks' ellipsoid at rest,
    * with remeshing every 10 iterations, 2 to 7 % of the points went through
    * the remesher at every remeshing (the share grows as the edges shrink:
-   * the flow is in mm per iteration); with this option 0.1 to 0.6 %, and
-   * the surface is the same (docs/performance.md). Far from the object the
+   * the flow is in mm per iteration); suppressed, 0.1 to 0.6 %, and the
+   * surface is the same (docs/performance.md). Far from the object the
    * step is long against the edges and the field moves neighbouring vertices
    * together; there the normal alone would not (neighbouring normals differ,
    * and long steps along them fold a fine mesh: with the bounds at h/4 and
    * h/2 the benchmark's 1M sphere came close to itself while it travelled),
-   * hence the whole force beyond h/4. Recommended with remeshing
-   * (RemeshingEdgeLength > 0). GetExternalForceMagnitudes() then gives the
-   * external force as applied, its tangential part dropped or weighted. */
-  itkSetMacro(SuppressTangentialDrift, bool);
-  itkGetConstMacro(SuppressTangentialDrift, bool);
-  itkBooleanMacro(SuppressTangentialDrift);
+   * hence the whole force beyond h/4.
+   *
+   * Why not without remeshing by default: a mesh that cannot gain vertices
+   * needs that flow to bring them where the surface bends most. On the seed
+   * paper's anisotropic ellipsoid without remeshing, suppressing it raised
+   * the largest distance to the surface from 0.52 to 0.70 voxel (balloon)
+   * and from 0.59 to 0.77 voxel (gradient vector flow); with remeshing the
+   * elongated ellipsoid's surface is the same either way (mean distance
+   * 0.118 voxel). GetExternalForceMagnitudes() gives the external force as
+   * applied, its tangential part dropped or weighted. */
+  itkSetEnumMacro(TangentialDrift, TangentialDriftEnum);
+  itkGetEnumMacro(TangentialDrift, TangentialDriftEnum);
+
+  /** Shorthand for TangentialDrift: on sets Suppress, off sets Keep. */
+  virtual void
+  SetSuppressTangentialDrift(bool suppress)
+  {
+    this->SetTangentialDrift(suppress ? TangentialDriftEnum::Suppress : TangentialDriftEnum::Keep);
+  }
+  virtual void
+  SuppressTangentialDriftOn()
+  {
+    this->SetSuppressTangentialDrift(true);
+  }
+  virtual void
+  SuppressTangentialDriftOff()
+  {
+    this->SetSuppressTangentialDrift(false);
+  }
+
+  /** Whether the tangential drift is suppressed with the current parameters:
+   * TangentialDrift is Suppress, or SuppressWhenRemeshing with
+   * RemeshingEdgeLength > 0. */
+  bool
+  GetSuppressTangentialDrift() const
+  {
+    return m_TangentialDrift == TangentialDriftEnum::Suppress ||
+           (m_TangentialDrift == TangentialDriftEnum::SuppressWhenRemeshing && m_RemeshingEdgeLength > 0.0);
+  }
 
   /** Weight b of the rigidity (bending, second order) internal force, the
    * umbrella operator applied twice: it penalises changes of curvature and
@@ -991,41 +1029,41 @@ private:
   void
   AddEdgeSearchSpeeds();
 
-  double        m_ScaleFactor{ 1.0 };
-  double        m_Elasticity{ 0.0 };
-  bool          m_TangentialElasticity{ true };
-  bool          m_SuppressTangentialDrift{ false };
-  double        m_Rigidity{ 0.0 };
-  double        m_Balloon{ 0.0 };
-  double        m_MaximumStepLength{ 0.0 };
-  double        m_ReferenceEdgeLength{ 0.0 };
-  unsigned int  m_MaximumNumberOfSubSteps{ 1000 };
-  unsigned int  m_NumberOfSubSteps{ 1 };
-  double        m_EdgeWeight{ 1.0 };
-  double        m_RegionWeight{ 0.0 };
-  double        m_RegionSigma{ 1.0 };
-  double        m_IntensityTolerance{ 2.2 };
-  bool          m_EstimateObjectIntensityRange{ true };
-  double        m_ObjectIntensityLower{ 0.0 };
-  double        m_ObjectIntensityUpper{ 0.0 };
-  double        m_ObjectIntensityWidth{ 1.0 };
-  double        m_ObjectIntensityMedian{ 0.0 };
-  double        m_ObjectIntensitySpread{ 0.0 };
-  bool          m_ObjectIntensityStatisticsGiven{ false };
-  double        m_EdgeSearchWeight{ 0.0 };
-  double        m_EdgeSearchDistance{ 2.0 };
-  int           m_EdgePolarity{ 0 };
-  SizeValueType m_NumberOfEdgeHits{ 0 };
-  bool          m_EstimateBackgroundIntensity{ true };
-  unsigned int  m_BackgroundUpdateInterval{ 10 };
-  double        m_ConvergenceTolerance{ 0.0 };
-  unsigned int  m_ConvergenceWindow{ 3 };
-  double        m_ConvergenceFraction{ 0.0 };
-  bool          m_ConvergenceAlongNormals{ false };
-  SizeValueType m_NumberOfActiveVertices{ 0 };
-  bool          m_FixedBoundary{ false };
-  SizeValueType m_NumberOfClosedContours{ 0 };
-  SizeValueType m_NumberOfOpenContours{ 0 };
+  double              m_ScaleFactor{ 1.0 };
+  double              m_Elasticity{ 0.0 };
+  bool                m_TangentialElasticity{ true };
+  TangentialDriftEnum m_TangentialDrift{ TangentialDriftEnum::SuppressWhenRemeshing };
+  double              m_Rigidity{ 0.0 };
+  double              m_Balloon{ 0.0 };
+  double              m_MaximumStepLength{ 0.0 };
+  double              m_ReferenceEdgeLength{ 0.0 };
+  unsigned int        m_MaximumNumberOfSubSteps{ 1000 };
+  unsigned int        m_NumberOfSubSteps{ 1 };
+  double              m_EdgeWeight{ 1.0 };
+  double              m_RegionWeight{ 0.0 };
+  double              m_RegionSigma{ 1.0 };
+  double              m_IntensityTolerance{ 2.2 };
+  bool                m_EstimateObjectIntensityRange{ true };
+  double              m_ObjectIntensityLower{ 0.0 };
+  double              m_ObjectIntensityUpper{ 0.0 };
+  double              m_ObjectIntensityWidth{ 1.0 };
+  double              m_ObjectIntensityMedian{ 0.0 };
+  double              m_ObjectIntensitySpread{ 0.0 };
+  bool                m_ObjectIntensityStatisticsGiven{ false };
+  double              m_EdgeSearchWeight{ 0.0 };
+  double              m_EdgeSearchDistance{ 2.0 };
+  int                 m_EdgePolarity{ 0 };
+  SizeValueType       m_NumberOfEdgeHits{ 0 };
+  bool                m_EstimateBackgroundIntensity{ true };
+  unsigned int        m_BackgroundUpdateInterval{ 10 };
+  double              m_ConvergenceTolerance{ 0.0 };
+  unsigned int        m_ConvergenceWindow{ 3 };
+  double              m_ConvergenceFraction{ 0.0 };
+  bool                m_ConvergenceAlongNormals{ false };
+  SizeValueType       m_NumberOfActiveVertices{ 0 };
+  bool                m_FixedBoundary{ false };
+  SizeValueType       m_NumberOfClosedContours{ 0 };
+  SizeValueType       m_NumberOfOpenContours{ 0 };
   // The boundary vertices (cache's numbering, increasing), found at reset;
   // for a 2-D mesh the first end of an open contour, or none (-1).
   std::vector<IndexType32> m_BoundaryVertices;

@@ -91,6 +91,12 @@ DeformableMeshFilter<TMesh, TForceImage>::VerifyPreconditions() const
   {
     itkExceptionMacro("RemeshingInterval must be at least 1 iteration; it is 0.");
   }
+  if (m_TangentialDrift != TangentialDriftEnum::Keep && m_TangentialDrift != TangentialDriftEnum::Suppress &&
+      m_TangentialDrift != TangentialDriftEnum::SuppressWhenRemeshing)
+  {
+    itkExceptionMacro("TangentialDrift must be Keep, Suppress or SuppressWhenRemeshing; it is "
+                      << static_cast<int>(m_TangentialDrift) << ".");
+  }
   if (!(m_MinimumDistance >= 0.0 && std::isfinite(m_MinimumDistance)))
   {
     itkExceptionMacro("MinimumDistance must be finite and non-negative; it is " << m_MinimumDistance << ".");
@@ -1440,9 +1446,9 @@ DeformableMeshFilter<TMesh, TForceImage>::Iterate()
   // reference edge length the geometry pass also gives the edge weights.
   const bool useImageTerms = this->UsesImageTerms();
   const bool scaled = m_ReferenceEdgeLength > 0.0 && (useElasticity || m_Rigidity > 0.0);
-  // SuppressTangentialDrift needs the normals and the mesh's edge length:
+  // Suppressing the tangential drift needs the normals and the mesh's edge length:
   // the geometry pass gives both.
-  const bool suppressDrift = m_SuppressTangentialDrift && m_ScaleFactor != 0.0;
+  const bool suppressDrift = this->GetSuppressTangentialDrift() && m_ScaleFactor != 0.0;
   const bool useRigidity = m_Rigidity > 0.0 || useImageTerms || scaled || m_ConvergenceAlongNormals || suppressDrift;
   const bool useNormal = m_Balloon != 0.0 || (useElasticity && m_TangentialElasticity) || useImageTerms ||
                          m_ConvergenceAlongNormals || suppressDrift;
@@ -2235,7 +2241,8 @@ DeformableMeshFilter<TMesh, TForceImage>::PrintSelf(std::ostream & os, Indent in
   os << indent << "ScaleFactor: " << m_ScaleFactor << std::endl;
   os << indent << "Elasticity: " << m_Elasticity << std::endl;
   os << indent << "TangentialElasticity: " << (m_TangentialElasticity ? "On" : "Off") << std::endl;
-  os << indent << "SuppressTangentialDrift: " << (m_SuppressTangentialDrift ? "On" : "Off") << std::endl;
+  os << indent << "TangentialDrift: " << m_TangentialDrift
+     << (this->GetSuppressTangentialDrift() ? " (suppressed)" : " (kept)") << std::endl;
   os << indent << "Rigidity: " << m_Rigidity << std::endl;
   os << indent << "Balloon: " << m_Balloon << std::endl;
   os << indent << "RegionWeight: " << m_RegionWeight << std::endl;

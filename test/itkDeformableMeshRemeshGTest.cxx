@@ -1301,6 +1301,78 @@ TEST(DeformableMeshRemeshing, SuppressTangentialDriftStopsTheFlowOfASurfaceAtRes
   EXPECT_NEAR(means[1], means[0], 0.01);
 }
 
+// TangentialDrift's default, SuppressWhenRemeshing: with remeshing the
+// filter gives the bits of Suppress, without it those of Keep; the boolean
+// shorthands set Suppress and Keep, GetSuppressTangentialDrift() says which
+// rule applies, PrintSelf names it, and a value outside the enumeration is
+// refused by name.
+TEST(DeformableMeshRemeshing, TangentialDriftIsSuppressedByDefaultWhenRemeshingOnly)
+{
+  using Drift = FilterType::TangentialDriftEnum;
+  {
+    auto filter = FilterType::New();
+    EXPECT_EQ(filter->GetTangentialDrift(), Drift::SuppressWhenRemeshing);
+    EXPECT_FALSE(filter->GetSuppressTangentialDrift());
+    filter->SetRemeshingEdgeLength(1.0);
+    EXPECT_TRUE(filter->GetSuppressTangentialDrift());
+    filter->SuppressTangentialDriftOff();
+    EXPECT_EQ(filter->GetTangentialDrift(), Drift::Keep);
+    EXPECT_FALSE(filter->GetSuppressTangentialDrift());
+    filter->SetRemeshingEdgeLength(0.0);
+    filter->SetSuppressTangentialDrift(true);
+    EXPECT_EQ(filter->GetTangentialDrift(), Drift::Suppress);
+    EXPECT_TRUE(filter->GetSuppressTangentialDrift());
+    std::ostringstream os;
+    filter->Print(os);
+    EXPECT_NE(os.str().find("TangentialDrift: Suppress (suppressed)"), std::string::npos) << os.str();
+  }
+
+  const ElongatedCase & c = Elongated();
+  // 35 iterations, remeshed after 10, 20 and 30 with edges of 1 voxel; and
+  // the same without remeshing.
+  for (const double edgeLength : { 1.0, 0.0 })
+  {
+    FlatMesh outputs[3];
+    for (const Drift drift : { Drift::SuppressWhenRemeshing, Drift::Suppress, Drift::Keep })
+    {
+      auto filter = c.MakeFilter(edgeLength, 35);
+      filter->SetTangentialDrift(drift);
+      filter->Update();
+      outputs[static_cast<int>(drift)] = OutputOf(filter);
+      if (drift == Drift::SuppressWhenRemeshing)
+      {
+        std::ostringstream os;
+        filter->Print(os);
+        const std::string expected = edgeLength > 0.0 ? "TangentialDrift: SuppressWhenRemeshing (suppressed)"
+                                                      : "TangentialDrift: SuppressWhenRemeshing (kept)";
+        EXPECT_NE(os.str().find(expected), std::string::npos) << expected;
+      }
+    }
+    const FlatMesh & byDefault = outputs[static_cast<int>(Drift::SuppressWhenRemeshing)];
+    const FlatMesh & same = outputs[static_cast<int>(edgeLength > 0.0 ? Drift::Suppress : Drift::Keep)];
+    const FlatMesh & other = outputs[static_cast<int>(edgeLength > 0.0 ? Drift::Keep : Drift::Suppress)];
+    EXPECT_EQ(byDefault.triangles, same.triangles) << "edge length " << edgeLength;
+    EXPECT_EQ(byDefault.x, same.x) << "edge length " << edgeLength;
+    EXPECT_NE(byDefault.x, other.x) << "edge length " << edgeLength << ": the two rules must differ here";
+  }
+
+  auto filter = c.MakeFilter(1.0, 1);
+  filter->SetTangentialDrift(static_cast<Drift>(7));
+  try
+  {
+    filter->Update();
+    ADD_FAILURE() << "a TangentialDrift of 7 was accepted";
+  }
+  catch (const itk::ExceptionObject & error)
+  {
+    EXPECT_NE(std::string(error.GetDescription())
+                .find("TangentialDrift must be Keep, Suppress or "
+                      "SuppressWhenRemeshing; it is 7."),
+              std::string::npos)
+      << error.GetDescription();
+  }
+}
+
 TEST(DeformableMeshRemeshing, ContinuationAbortAndResetGiveTheSameMeshAcrossRemeshings)
 {
   // 35 iterations, remeshing after 10, 20 and 30: all at once, one step per
@@ -1407,6 +1479,10 @@ TEST(DeformableMeshRemeshing, StepAfterARemeshingIsThatOfANewFilterOnItsOutput)
   fresh->SetInput(input);
   fresh->SetBalloon(0.0);
   fresh->SetRenumberForLocality(false);
+  // The remeshing filter suppresses the tangential drift by default; the
+  // new one does not remesh, so it is told to.
+  ASSERT_TRUE(remeshing->GetSuppressTangentialDrift());
+  fresh->SetSuppressTangentialDrift(true);
   fresh->Update();
   remeshing->SetNumberOfIterations(26);
   remeshing->Update();

@@ -139,7 +139,7 @@ vtkDeformableMesh::vtkDeformableMesh()
   this->MaximumStepLength = filter->GetMaximumStepLength();
   this->RemeshingEdgeLength = filter->GetRemeshingEdgeLength();
   this->RemeshingInterval = static_cast<int>(filter->GetRemeshingInterval());
-  this->SuppressTangentialDrift = filter->GetSuppressTangentialDrift() ? 1 : 0;
+  this->TangentialDrift = static_cast<int>(filter->GetTangentialDrift());
   this->ReferenceEdgeLength = filter->GetReferenceEdgeLength();
   this->ConvergenceAlongNormals = filter->GetConvergenceAlongNormals() ? 1 : 0;
   this->PreventSelfIntersections = filter->GetPreventSelfIntersections() ? 1 : 0;
@@ -432,7 +432,7 @@ vtkDeformableMesh::PrepareFilter(vtkInformationVector ** inputVector)
     filter->SetMaximumStepLength(this->MaximumStepLength);
     filter->SetRemeshingEdgeLength(this->RemeshingEdgeLength);
     filter->SetRemeshingInterval(static_cast<unsigned int>(this->RemeshingInterval));
-    filter->SetSuppressTangentialDrift(this->SuppressTangentialDrift != 0);
+    filter->SetTangentialDrift(static_cast<itk::DeformableMeshFilterEnums::TangentialDrift>(this->TangentialDrift));
     filter->SetReferenceEdgeLength(this->ReferenceEdgeLength);
     filter->SetConvergenceAlongNormals(this->ConvergenceAlongNormals != 0);
     filter->SetPreventSelfIntersections(this->PreventSelfIntersections != 0);
@@ -513,7 +513,7 @@ vtkDeformableMesh::PrintSelf(ostream & os, vtkIndent indent)
   os << indent << "MaximumStepLength: " << this->MaximumStepLength << "\n";
   os << indent << "RemeshingEdgeLength: " << this->RemeshingEdgeLength << "\n";
   os << indent << "RemeshingInterval: " << this->RemeshingInterval << "\n";
-  os << indent << "SuppressTangentialDrift: " << (this->SuppressTangentialDrift ? "On" : "Off") << "\n";
+  os << indent << "TangentialDrift: " << this->TangentialDrift << "\n";
   os << indent << "ReferenceEdgeLength: " << this->ReferenceEdgeLength << "\n";
   os << indent << "ConvergenceAlongNormals: " << (this->ConvergenceAlongNormals ? "On" : "Off") << "\n";
   os << indent << "PreventSelfIntersections: " << (this->PreventSelfIntersections ? "On" : "Off") << "\n";

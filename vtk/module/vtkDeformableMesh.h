@@ -307,17 +307,56 @@ public:
 
   ///@{
   /**
-   * Drop the external force's component tangent to the surface where the
-   * surface has come to rest (external displacement below an eighth of the
-   * mesh's root mean square edge length; whole beyond a quarter of it): the
-   * vertices of a converged surface then stop flowing along it, and the
-   * remeshings stop splitting and collapsing edges. Recommended with
-   * remeshing. Default off.
-   * Meaning in full: itk::DeformableMeshFilter::SetSuppressTangentialDrift().
+   * What becomes of the external force's component tangent to the surface
+   * where the surface has come to rest (external displacement below an
+   * eighth of the mesh's root mean square edge length; whole beyond a
+   * quarter of it). TANGENTIAL_DRIFT_KEEP (0): the force acts whole.
+   * TANGENTIAL_DRIFT_SUPPRESS (1): dropped at rest, so the vertices of a
+   * converged surface stop flowing along it and the remeshings stop
+   * splitting and collapsing edges. TANGENTIAL_DRIFT_SUPPRESS_WHEN_REMESHING
+   * (2, the default): suppressed when RemeshingEdgeLength > 0, kept
+   * otherwise. SetSuppressTangentialDrift(), SuppressTangentialDriftOn() and
+   * Off() are shorthands for 1 and 0.
+   * Meaning in full: itk::DeformableMeshFilter::SetTangentialDrift().
    */
-  vtkSetMacro(SuppressTangentialDrift, vtkTypeBool);
-  vtkGetMacro(SuppressTangentialDrift, vtkTypeBool);
-  vtkBooleanMacro(SuppressTangentialDrift, vtkTypeBool);
+  enum TangentialDriftModes
+  {
+    TANGENTIAL_DRIFT_KEEP = 0,
+    TANGENTIAL_DRIFT_SUPPRESS = 1,
+    TANGENTIAL_DRIFT_SUPPRESS_WHEN_REMESHING = 2
+  };
+  vtkSetClampMacro(TangentialDrift, int, TANGENTIAL_DRIFT_KEEP, TANGENTIAL_DRIFT_SUPPRESS_WHEN_REMESHING);
+  vtkGetMacro(TangentialDrift, int);
+  void
+  SetTangentialDriftToKeep()
+  {
+    this->SetTangentialDrift(TANGENTIAL_DRIFT_KEEP);
+  }
+  void
+  SetTangentialDriftToSuppress()
+  {
+    this->SetTangentialDrift(TANGENTIAL_DRIFT_SUPPRESS);
+  }
+  void
+  SetTangentialDriftToSuppressWhenRemeshing()
+  {
+    this->SetTangentialDrift(TANGENTIAL_DRIFT_SUPPRESS_WHEN_REMESHING);
+  }
+  void
+  SetSuppressTangentialDrift(vtkTypeBool suppress)
+  {
+    this->SetTangentialDrift(suppress ? TANGENTIAL_DRIFT_SUPPRESS : TANGENTIAL_DRIFT_KEEP);
+  }
+  void
+  SuppressTangentialDriftOn()
+  {
+    this->SetSuppressTangentialDrift(1);
+  }
+  void
+  SuppressTangentialDriftOff()
+  {
+    this->SetSuppressTangentialDrift(0);
+  }
   ///@}
 
   ///@{
@@ -490,7 +529,7 @@ protected:
   double      MaximumStepLength = 0.0;
   double      RemeshingEdgeLength = 0.0;
   int         RemeshingInterval = 10;
-  vtkTypeBool SuppressTangentialDrift = 0;
+  int         TangentialDrift = TANGENTIAL_DRIFT_SUPPRESS_WHEN_REMESHING;
   double      RegionWeight = 0.0;
   double      RegionSigma = 1.0;
   double      EdgeSearchWeight = 0.0;

@@ -798,7 +798,7 @@ TEST(VTKIterativeAlgorithms, PrintSelfPrintsEveryParameter)
                              "MaximumStepLength",
                              "RemeshingEdgeLength",
                              "RemeshingInterval",
-                             "SuppressTangentialDrift",
+                             "TangentialDrift",
                              "ReferenceEdgeLength",
                              "ConvergenceAlongNormals",
                              "PreventSelfIntersections",
